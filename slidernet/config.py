@@ -1,0 +1,256 @@
+"""Run configuration: pydantic models loaded from TOML or a dict.
+
+Every check happens here, before any work: structure and ranges through
+pydantic, plugin names and parameters by building the plugins. Errors are
+raised as :class:`~slidernet.errors.ConfigError` with the dotted name of the
+field and the reason.
+
+>>> cfg = load_config({"steps": 10, "network": {"Ntilde": 1e-7},
+...                    "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6,
+...                                 "std": 0.01}},
+...                    "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}})
+>>> cfg.network.kind, cfg.realizations
+('two_slider', 1)
+>>> load_config({"steps": 0})
+Traceback (most recent call last):
+...
+slidernet.errors.ConfigError: Invalid configuration:
+  - The 'steps' field must be >= 1. Got 0 instead.
+  - The 'network' field is required.
+  - The 'friction' field is required.
+  - The 'driver' field is required.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+
+from slidernet import registry
+from slidernet.distributions import TruncatedBelow
+from slidernet.errors import ConfigError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class PluginSpec(BaseModel):
+    """A registered plugin by ``name``; every other key is a parameter of its factory."""
+
+    model_config = ConfigDict(extra="allow")
+    name: str
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The factory's keyword arguments."""
+        return dict(self.model_extra or {})
+
+
+class NetworkConfig(_Strict):
+    """The network: the paper's ``two_slider`` or a ``chain`` of ``n`` sliders."""
+
+    kind: Literal["two_slider", "chain"] = "two_slider"
+    Ntilde: PositiveFloat
+    n: Annotated[int, Field(ge=2)] | None = None
+
+    @model_validator(mode="after")
+    def _n_matches_kind(self) -> NetworkConfig:
+        if self.kind == "chain" and self.n is None:
+            raise ValueError("a chain needs 'n', its number of sliders")
+        if self.kind == "two_slider" and self.n not in (None, 2):
+            raise ValueError(f"two_slider has n = 2 sliders; got n = {self.n}")
+        return self
+
+
+class FrictionConfig(_Strict):
+    """Dynamic coefficient mu_d and the distribution of static thresholds mu_s."""
+
+    mu_d: PositiveFloat
+    static: PluginSpec
+
+
+class SolverConfig(_Strict):
+    """Choices of the quasi-static solver.
+
+    ``kernel = "auto"`` picks the scalar ``pair`` kernel for the paper's
+    two-slider scene and the general ``csr`` kernel otherwise.
+    """
+
+    kernel: Literal["auto", "pair", "csr"] = "auto"
+    max_avalanche: Annotated[int, Field(ge=1)] = 100_000_000
+    batch: Annotated[int, Field(ge=16)] = 1 << 16
+
+
+class Config(_Strict):
+    """A full run: what to simulate, for how long, and what to record."""
+
+    seed: Annotated[int, Field(ge=0)] | None = None
+    realizations: Annotated[int, Field(ge=1)] = 1
+    steps: Annotated[int, Field(ge=1)]
+    record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = "log"
+    log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = 20
+    observables: list[Literal["n", "mu_max", "x_G", "mu_eff", "n_records"]] = Field(
+        default_factory=lambda: ["n", "mu_max", "x_G"]
+    )
+    network: NetworkConfig
+    friction: FrictionConfig
+    driver: PluginSpec
+    solver: SolverConfig = Field(default_factory=SolverConfig)
+
+    _distribution: Any = PrivateAttr(default=None)
+    _driver: Any = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _check_cross_fields(self) -> Config:
+        if isinstance(self.record, list):
+            if any(t > self.steps for t in self.record):
+                raise ValueError(f"record times must lie in [0, steps = {self.steps}]")
+        if "mu_eff" in self.observables and self.n_nodes != 2:
+            raise ValueError(
+                "the 'mu_eff' observable (the appendix's tilt test) is defined for 2 sliders; "
+                f"this network has {self.n_nodes}"
+            )
+        if self.solver.kernel == "pair" and self.network.kind == "chain" and self.n_nodes != 2:
+            raise ValueError("solver.kernel = 'pair' needs a 2-slider network")
+        return self
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of sliders in the configured network."""
+        return 2 if self.network.kind == "two_slider" else int(self.network.n)
+
+    def distribution(self) -> TruncatedBelow:
+        """The mu_s distribution, truncated below mu_d (built once, cached)."""
+        if self._distribution is None:
+            self._distribution = build_distribution(self.friction)
+        return self._distribution
+
+    def driver_plugin(self) -> Any:
+        """The temperature driver (built once, cached)."""
+        if self._driver is None:
+            self._driver = _build_plugin(registry.drivers, self.driver, "driver")
+        return self._driver
+
+
+def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
+    factory = reg.get(spec.name)
+    params = spec.params
+    try:
+        inspect.signature(factory).bind(**params)
+    except TypeError as exc:
+        try:
+            names = ", ".join(repr(p) for p in inspect.signature(factory).parameters)
+        except (TypeError, ValueError):  # pragma: no cover - builtins without signature
+            names = "?"
+        raise ConfigError(
+            f"The '{field}' field: the {reg.kind} {spec.name!r} does not accept "
+            f"{sorted(params)}: {exc}. Its parameters are {names}."
+        ) from None
+    except ValueError:  # pragma: no cover - no introspectable signature
+        pass
+    try:
+        return factory(**params)
+    except ConfigError as exc:
+        raise ConfigError(f"The '{field}' field: {exc}") from None
+
+
+def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
+    """Build the mu_s plugin and truncate it below mu_d (MODEL.md section 1)."""
+    dist = _build_plugin(registry.distributions, friction.static, "friction.static")
+    check = getattr(dist, "check_mu_d", None)
+    if check is not None:
+        try:
+            check(friction.mu_d)
+        except ConfigError as exc:
+            raise ConfigError(f"The 'friction.static' field: {exc}") from None
+    try:
+        return TruncatedBelow(dist, friction.mu_d, friction.static.name)
+    except ConfigError as exc:
+        raise ConfigError(f"The 'friction.static' field: {exc}") from None
+
+
+def _describe(err: Mapping[str, Any]) -> str:
+    loc = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-after"))
+    kind = err["type"]
+    ctx = err.get("ctx") or {}
+    got = err.get("input")
+    if kind == "missing":
+        return f"The {loc!r} field is required."
+    if kind == "extra_forbidden":
+        parent, _, key = loc.rpartition(".")
+        where = f" in [{parent}]" if parent else ""
+        return f"Unknown key {key!r}{where}."
+    bounds = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",
+              "less_than_equal": "<="}
+    if kind in bounds:
+        limit = next(iter(ctx.values()))
+        return f"The {loc!r} field must be {bounds[kind]} {limit}. Got {got!r} instead."
+    if kind == "finite_number":
+        return f"The {loc!r} field must be a finite number. Got {got!r} instead."
+    if kind == "value_error":
+        msg = str(ctx.get("error", err["msg"]))
+        return f"The {loc!r} field: {msg}." if loc else f"{msg[0].upper()}{msg[1:]}."
+    return f"The {loc!r} field: {err['msg']}. Got {got!r} instead."
+
+
+def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
+    """Validate a configuration and build its plugins.
+
+    Parameters
+    ----------
+    source : Config, mapping, or path
+        A :class:`Config`, a dict with the keys of MODEL.md section 5, or the
+        path of a TOML file with those keys.
+
+    Returns
+    -------
+    Config
+        The validated configuration, with its plugins already built.
+
+    Raises
+    ------
+    ConfigError
+        On any invalid field; the message names the field and the reason.
+    """
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        try:
+            with path.open("rb") as fh:
+                source = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+    if isinstance(source, Config):
+        cfg = source
+    else:
+        if not isinstance(source, Mapping):
+            raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
+        try:
+            cfg = Config.model_validate(dict(source))
+        except ValidationError as exc:
+            lines = "\n".join(f"  - {_describe(e)}" for e in exc.errors())
+            raise ConfigError(f"Invalid configuration:\n{lines}") from None
+    cfg.distribution()
+    cfg.driver_plugin()
+    return cfg
+
+
+def is_finite(x: float) -> bool:
+    """True for a finite float (helper for plugin validation)."""
+    return math.isfinite(x)

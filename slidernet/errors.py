@@ -1,0 +1,42 @@
+"""Exception classes of slidernet.
+
+Every class subclasses a builtin so that ``except ValueError`` keeps working
+for callers who do not know slidernet's own types.
+"""
+
+from __future__ import annotations
+
+
+class SlidernetError(Exception):
+    """Base class of every error raised by slidernet."""
+
+
+class ConfigError(SlidernetError, ValueError):
+    """A configuration value is invalid; raised before any work is done."""
+
+
+class UnknownPluginError(ConfigError):
+    """A distribution or driver name is not registered."""
+
+
+class PluginError(SlidernetError, RuntimeError):
+    """A plugin returned values that break the model's contract (NaN, mu_s <= mu_d, ...)."""
+
+
+class AvalancheError(SlidernetError, RuntimeError):
+    """An avalanche did not end within the allowed number of slips."""
+
+
+class TiltTestError(SlidernetError, RuntimeError):
+    """The virtual tilt test did not reach a sliding state within its iteration cap."""
+
+
+def param_error(param: str, owner: str, requirement: str, got: object) -> ConfigError:
+    """Build the standard message for a bad parameter value.
+
+    >>> print(param_error("sigma_theta", "gaussian_steps", "> 0", -1e-06))
+    The 'sigma_theta' parameter of gaussian_steps must be > 0. Got -1e-06 instead.
+    """
+    return ConfigError(
+        f"The {param!r} parameter of {owner} must be {requirement}. Got {got!r} instead."
+    )

@@ -1,0 +1,147 @@
+"""Plugin registries: built-ins plus ``importlib.metadata`` entry points.
+
+Two registries exist, one per entry-point group:
+
+* ``slidernet.distributions`` -- distributions of the static threshold mu_s;
+* ``slidernet.drivers`` -- temperature (thermal dilation theta) drivers.
+
+A registry maps a name to a *factory*: ``factory(**params)`` returns the plugin
+object. The built-ins are always there; third-party packages add names through
+their entry points, which are looked up lazily (on the first lookup) and
+cached. Names registered at run time with :func:`register_distribution` or
+:func:`register_driver` take precedence over entry points.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from importlib.metadata import EntryPoint, entry_points
+from typing import Any
+
+from slidernet.errors import UnknownPluginError
+
+Factory = Callable[..., Any]
+
+
+class Registry:
+    """A name -> factory mapping, backed by an entry-point group.
+
+    Parameters
+    ----------
+    group : str
+        The entry-point group searched for third-party plugins.
+    kind : str
+        Human-readable name of what is registered, used in error messages.
+    builtins : dict of str to callable
+        The factories that ship with slidernet.
+
+    Examples
+    --------
+    >>> reg = Registry("slidernet.examples", "example", {"one": lambda: 1})
+    >>> reg.get("one")()
+    1
+    >>> reg.get("two")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.UnknownPluginError: Unknown example 'two'. Available: 'one'.
+    """
+
+    def __init__(self, group: str, kind: str, builtins: dict[str, Factory]) -> None:
+        self.group = group
+        self.kind = kind
+        self._builtins = dict(builtins)
+        self._runtime: dict[str, Factory] = {}
+        self._entry_points: dict[str, EntryPoint] | None = None
+        self._loaded: dict[str, Factory] = {}
+
+    def _discover(self) -> dict[str, EntryPoint]:
+        if self._entry_points is None:
+            self._entry_points = {ep.name: ep for ep in entry_points(group=self.group)}
+        return self._entry_points
+
+    def register(self, name: str, factory: Factory) -> None:
+        """Register ``factory`` under ``name`` for this process."""
+        if not isinstance(name, str) or not name:
+            raise TypeError(f"A {self.kind} name must be a non-empty string. Got {name!r}.")
+        if not callable(factory):
+            raise TypeError(f"The factory of {self.kind} {name!r} must be callable.")
+        self._runtime[name] = factory
+
+    def names(self) -> list[str]:
+        """Every available name: built-ins, entry points and run-time registrations."""
+        return sorted(set(self._builtins) | set(self._discover()) | set(self._runtime))
+
+    def get(self, name: str) -> Factory:
+        """Return the factory registered as ``name``.
+
+        Raises
+        ------
+        UnknownPluginError
+            If no plugin has that name; the message lists the available ones.
+        """
+        if name in self._runtime:
+            return self._runtime[name]
+        if name in self._builtins:
+            return self._builtins[name]
+        if name in self._loaded:
+            return self._loaded[name]
+        ep = self._discover().get(name)
+        if ep is not None:
+            try:
+                factory = ep.load()
+            except Exception as exc:  # a broken third-party package must not break the registry
+                warnings.warn(
+                    f"The {self.kind} plugin {name!r} ({ep.value}) failed to load: {exc!r}",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+            else:
+                self._loaded[name] = factory
+                return factory
+        available = ", ".join(repr(n) for n in self.names())
+        raise UnknownPluginError(f"Unknown {self.kind} {name!r}. Available: {available}.")
+
+    def create(self, name: str, **params: Any) -> Any:
+        """Look up ``name`` and call its factory with ``params``."""
+        return self.get(name)(**params)
+
+    def clear_cache(self) -> None:
+        """Forget discovered entry points (for tests and for newly installed packages)."""
+        self._entry_points = None
+        self._loaded.clear()
+
+
+def _builtin_distributions() -> dict[str, Factory]:
+    from slidernet.distributions import Gaussian
+
+    return {"gaussian": Gaussian}
+
+
+def _builtin_drivers() -> dict[str, Factory]:
+    from slidernet.drivers import GaussianSteps
+
+    return {"gaussian_steps": GaussianSteps}
+
+
+distributions = Registry("slidernet.distributions", "distribution", _builtin_distributions())
+drivers = Registry("slidernet.drivers", "driver", _builtin_drivers())
+
+
+def register_distribution(name: str, factory: Factory) -> None:
+    """Register a distribution of mu_s under ``name``.
+
+    ``factory(**params)`` must return an object with ``sample(rng, size)``
+    (an ndarray of ``size`` floats) and ``cdf(x)``; ``sf(x)`` is optional and
+    improves the accuracy of the extreme-value theory in the far tail.
+    """
+    distributions.register(name, factory)
+
+
+def register_driver(name: str, factory: Factory) -> None:
+    """Register a temperature driver under ``name``.
+
+    ``factory(**params)`` must return an object with ``thetas(rng, steps)``,
+    the ``steps + 1`` values of theta at t = 0, 1, ..., steps (in tau_th).
+    """
+    drivers.register(name, factory)

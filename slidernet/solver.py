@@ -1,0 +1,239 @@
+"""The quasi-static, event-driven solver: from a validated config to raw records.
+
+Data flow for one realization (see ARCHITECTURE.md)::
+
+    SeedSequence child r --spawn(3)--> [driver, thresholds, tilt]
+    driver.thetas(rng_driver, steps)      -> theta(t_q), q = 0..steps
+    dist.sample(rng_thresholds, N)        -> initial mu_s, then batches
+    kernel (pair or csr) over the thetas  -> records at the recorded times
+
+No time stepping: within each linear segment of theta the kernel jumps from
+one rearrangement to the next by solving eq. `critique` exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from slidernet import kernels
+from slidernet.config import Config
+from slidernet.errors import AvalancheError, PluginError, TiltTestError
+from slidernet.network import Network, chain, two_slider
+
+
+def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> np.ndarray:
+    """Recorded times in tau_th, always including 0 and ``steps``.
+
+    >>> record_times(100, "log", per_decade=2).tolist()
+    [0, 1, 3, 10, 32, 100]
+    >>> record_times(3, "all").tolist()
+    [0, 1, 2, 3]
+    """
+    if record == "all":
+        t = np.arange(steps + 1)
+    elif record == "log":
+        decades = np.log10(steps) if steps > 1 else 0.0
+        npts = max(int(np.ceil(decades * per_decade)) + 1, 2)
+        t = np.round(np.logspace(0.0, decades, npts)).astype(np.int64)
+    else:
+        t = np.asarray(record, dtype=np.int64)
+    return np.unique(np.concatenate([[0, steps], t])).astype(np.int64)
+
+
+def build_network(cfg: Config) -> Network:
+    """The network of the configured scene."""
+    if cfg.network.kind == "two_slider":
+        return two_slider(cfg.network.Ntilde)
+    return chain(cfg.network.n, Ntilde=cfg.network.Ntilde)
+
+
+@dataclass
+class Scene:
+    """Everything a realization needs, derived once from a :class:`Config`.
+
+    Attributes
+    ----------
+    kernel : {"pair", "csr"}
+        The specialized kernel picked for this scene.
+    """
+
+    network: Network
+    distribution: Any
+    driver: Any
+    driver_name: str
+    distribution_name: str
+    mu_d: float
+    steps: int
+    rec_times: np.ndarray
+    kernel: str
+    do_tilt: bool
+    max_avalanche: int
+    batch: int
+    csr: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @classmethod
+    def from_config(cls, cfg: Config) -> Scene:
+        """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
+        net = build_network(cfg)
+        kernel = cfg.solver.kernel
+        if kernel == "auto":
+            kernel = "pair" if net.is_two_slider() else "csr"
+        K = net.stiffness_matrix()
+        g = net.thermal_load()
+        csr = {
+            "indptr": K.indptr.astype(np.int64),
+            "indices": K.indices.astype(np.int64),
+            "kdata": K.data.astype(np.float64),
+            "kdiag": K.diagonal().astype(np.float64),
+            "g": g.astype(np.float64),
+            "normal_load": net.normal_load.copy(),
+            "w": net.normal_load / net.normal_load.sum(),
+            "driven": np.flatnonzero(g != 0).astype(np.int64),
+        }
+        return cls(
+            network=net,
+            distribution=cfg.distribution(),
+            driver=cfg.driver_plugin(),
+            driver_name=cfg.driver.name,
+            distribution_name=cfg.friction.static.name,
+            mu_d=cfg.friction.mu_d,
+            steps=cfg.steps,
+            rec_times=record_times(cfg.steps, cfg.record, cfg.log_points_per_decade),
+            kernel=kernel,
+            do_tilt="mu_eff" in cfg.observables,
+            max_avalanche=cfg.solver.max_avalanche,
+            batch=cfg.solver.batch,
+            csr=csr,
+        )
+
+
+def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random.Generator]:
+    """The three independent streams of one realization, in their documented order.
+
+    ``seed_seq.spawn(3)`` gives, in order: the driver, the thresholds of the
+    horizontal evolution, and the virtual tilt test. The tilt test never
+    touches the other two, so requesting ``mu_eff`` leaves n, mu_max and x_G
+    unchanged to the bit.
+    """
+    names = ("driver", "thresholds", "tilt")
+    return {
+        name: np.random.Generator(np.random.PCG64(child))
+        for name, child in zip(names, seed_seq.spawn(3), strict=True)
+    }
+
+
+def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
+    """theta(t_q) from the driver plugin, checked: shape (steps + 1,), finite."""
+    thetas = np.asarray(scene.driver.thetas(rng, scene.steps), dtype=np.float64)
+    if thetas.shape != (scene.steps + 1,):
+        raise PluginError(
+            f"The driver {scene.driver_name!r} returned shape {thetas.shape} from "
+            f"thetas(rng, {scene.steps}); expected ({scene.steps + 1},)."
+        )
+    if not np.isfinite(thetas).all():
+        raise PluginError(f"The driver {scene.driver_name!r} returned NaN or inf values.")
+    return thetas
+
+
+def _refill(buf: np.ndarray, pos: int, fresh: np.ndarray) -> np.ndarray:
+    # Keep the unread tail: the stream of draws is then the same whatever
+    # point the kernel stopped at.
+    return np.concatenate([buf[pos:], fresh])
+
+
+def simulate(scene: Scene, seed_seq: np.random.SeedSequence) -> dict[str, np.ndarray]:
+    """Run one realization; return its records at ``scene.rec_times``.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
+        (T,), and the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
+        record bin, shape (T,), where T = ``scene.rec_times.size``.
+    """
+    rngs = realization_streams(seed_seq)
+    net = scene.network
+    Ntilde = net.Ntilde
+    thetas = draw_thetas(scene, rngs["driver"]) / Ntilde
+    dist = scene.distribution
+    mu = dist.sample(rngs["thresholds"], net.n_nodes).astype(np.float64)
+    mu_buf = dist.sample(rngs["thresholds"], scene.batch)
+    if scene.do_tilt:
+        tmu = dist.sample(rngs["tilt"], scene.batch)
+        tu = rngs["tilt"].random(scene.batch)
+    else:
+        tmu = np.empty(0)
+        tu = np.empty(0)
+
+    T = scene.rec_times.size
+    out = {
+        "n": np.zeros(T, np.int64),
+        "mu_max": np.zeros(T),
+        "x_G": np.zeros(T),
+        "n_records": np.zeros(T, np.int64),
+        "f_sum": np.zeros(T),
+        "f_sq": np.zeros(T),
+        "f_count": np.zeros(T, np.int64),
+    }
+    ist, fst = kernels.empty_state()
+    fst[kernels.THETA] = thetas[0]
+    fst[kernels.U] = thetas[0]  # the spring at rest at theta(0): u = theta(0)
+    fst[kernels.MU_MAX] = mu.max()
+    ist[kernels.ARGMAX] = int(np.argmax(mu))
+
+    c = scene.csr
+    if scene.kernel == "csr":
+        # a = F - theta g with u = 0: every spring at rest at theta(0).
+        a = -c["g"] * thetas[0]
+        u = np.zeros(net.n_nodes)
+        heap = np.zeros(net.n_nodes, np.int64)
+        pos = np.full(net.n_nodes, -1, np.int64)
+        key = np.zeros(net.n_nodes)
+
+    while True:
+        if scene.kernel == "pair":
+            status = kernels.run_pair(
+                thetas, scene.rec_times, mu, ist, fst, mu_buf, tmu, tu, scene.mu_d,
+                scene.do_tilt, scene.max_avalanche, out["n"], out["mu_max"], out["x_G"],
+                out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
+            )
+        else:
+            status = kernels.run_csr(
+                thetas, scene.rec_times, mu, ist, fst, a, u, mu_buf, tmu, tu, scene.mu_d,
+                scene.do_tilt, scene.max_avalanche, c["indptr"], c["indices"], c["kdata"],
+                c["kdiag"], c["g"], c["normal_load"], c["w"], c["driven"], heap, pos, key,
+                out["n"], out["mu_max"], out["x_G"], out["n_records"], out["f_sum"],
+                out["f_sq"], out["f_count"],
+            )
+        if status == kernels.DONE:
+            break
+        if status == kernels.NEED_MU:
+            mu_buf = _refill(mu_buf, ist[kernels.MU_POS],
+                             dist.sample(rngs["thresholds"], scene.batch))
+            ist[kernels.MU_POS] = 0
+        elif status == kernels.NEED_TILT:
+            tmu = _refill(tmu, ist[kernels.TMU_POS], dist.sample(rngs["tilt"], scene.batch))
+            tu = _refill(tu, ist[kernels.TU_POS], rngs["tilt"].random(scene.batch))
+            ist[kernels.TMU_POS] = 0
+            ist[kernels.TU_POS] = 0
+        elif status == kernels.AVALANCHE_LIMIT:
+            i = int(ist[kernels.ERR_NODE])
+            theta = fst[kernels.THETA] * Ntilde
+            raise AvalancheError(
+                f"An avalanche did not end after {scene.max_avalanche} slips "
+                f"(solver.max_avalanche) during step {ist[kernels.Q]}: node {i} is still "
+                f"unstable with mu_s = {mu[i]!r} at theta = {theta!r}."
+            )
+        elif status == kernels.TILT_LIMIT:
+            raise TiltTestError(
+                f"The tilt test did not reach sliding within {kernels.TILT_MAX_ITER} "
+                f"iterations at step {ist[kernels.Q]}."
+            )
+        else:  # pragma: no cover - a new status code without a handler is a bug
+            raise RuntimeError(f"unknown kernel status {status}")
+    out["x_G"] *= Ntilde
+    out["n_events"] = np.int64(ist[kernels.N_EVENTS])
+    return out

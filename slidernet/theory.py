@@ -1,0 +1,501 @@
+"""Closed-form predictions of the two-slider model (the paper's section IV).
+
+Everything here is a reference to compare simulations against; nothing is
+simulated. Units follow MODEL.md: lengths in l0, time in tau_th, friction
+coefficients dimensionless. ``n`` is always the number of rearrangements
+since t = 0, so the initial state holds two drawn thresholds and after ``n``
+rearrangements ``n + 2`` thresholds have been drawn in all (MODEL.md,
+section 4). The paper counts from an initial step n = 1 and therefore writes
+``n + 1`` for the same number.
+
+Two kinds of results live side by side and the docstrings say which is which:
+
+* exact statements about the threshold sequence, which hold for every
+  distribution p(mu_s) -- :func:`mu_max_cdf`, :func:`mu_max_moments`,
+  :func:`harmonic`, :func:`mean_records`;
+* the paper's approximate laws -- :func:`mean_rearrangements` (eq. ``slope``),
+  :func:`mu_max_leading` (eq. ``mumaxth``) and :func:`msd` (order of
+  magnitude only).
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import special
+
+from slidernet.errors import ConfigError, param_error
+
+__all__ = [
+    "harmonic",
+    "mean_rearrangements",
+    "mean_records",
+    "msd",
+    "mu_max_cdf",
+    "mu_max_leading",
+    "mu_max_moments",
+]
+
+# Probability mass left out at each end of the integration range of
+# mu_max_moments: far below double precision relative to the moments.
+_TAIL_EPS = 1e-17
+# Gauss-Legendre nodes across that range. The integrand 1 - F^m is smooth and
+# spans a few dozen Gumbel widths at most, so 2000 nodes converge to rounding.
+_N_NODES = 2000
+# H_k is tabulated exactly (correctly rounded from rationals) up to this k;
+# above it digamma is accurate to a few ulp and a table would be wasteful.
+_H_TABLE_MAX = 1024
+
+
+def _exact_harmonic_table(kmax: int) -> np.ndarray:
+    total = Fraction(0)
+    table = [0.0]
+    for k in range(1, kmax + 1):
+        total += Fraction(1, k)
+        table.append(float(total))
+    return np.array(table)
+
+
+_H_TABLE = _exact_harmonic_table(_H_TABLE_MAX)
+
+
+# ---------------------------------------------------------------------------
+# validation helpers
+
+
+def _as_float_array(value: ArrayLike, param: str, owner: str) -> np.ndarray:
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise param_error(param, owner, "a real number or an array of them", value) from None
+
+
+def _first_bad(arr: np.ndarray, bad: np.ndarray) -> float:
+    # Report one offending element, not a whole (possibly huge) array.
+    return float(arr[bad].flat[0])
+
+
+def _check_finite(value: ArrayLike, param: str, owner: str) -> np.ndarray:
+    arr = _as_float_array(value, param, owner)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise param_error(param, owner, "finite", _first_bad(arr, bad))
+    return arr
+
+
+def _check_positive(value: ArrayLike, param: str, owner: str) -> np.ndarray:
+    arr = _as_float_array(value, param, owner)
+    # NaN fails ``arr > 0`` as well, so it is reported here too.
+    bad = ~(np.isfinite(arr) & (arr > 0))
+    if bad.any():
+        raise param_error(param, owner, "finite and > 0", _first_bad(arr, bad))
+    return arr
+
+
+def _check_count(n: ArrayLike, owner: str) -> np.ndarray:
+    arr = _as_float_array(n, "n", owner)
+    bad = ~(np.isfinite(arr) & (arr >= 0))
+    if bad.any():
+        raise param_error("n", owner, "finite and >= 0", _first_bad(arr, bad))
+    return arr
+
+
+def _check_dist(dist: Any, owner: str) -> None:
+    if not callable(getattr(dist, "cdf", None)):
+        raise param_error("dist", owner, "a distribution with a cdf(x) method", dist)
+
+
+def _log_cdf(dist: Any, x: np.ndarray) -> np.ndarray:
+    """log F(x), accurate in the upper tail when ``dist`` has ``sf``."""
+    sf = getattr(dist, "sf", None)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if sf is not None:
+            # log1p(-sf) keeps the tail 1 - F ~ 1e-26 that 1 - cdf rounds to 0.
+            return np.log1p(-np.clip(np.asarray(sf(x), dtype=float), 0.0, 1.0))
+        return np.log(np.clip(np.asarray(dist.cdf(x), dtype=float), 0.0, 1.0))
+
+
+# ---------------------------------------------------------------------------
+# rearrangement rate
+
+
+def mean_rearrangements(
+    sigma_theta: ArrayLike,
+    Ntilde: float,
+    mu_d: float,
+    mu_s_mean: float,
+    offset: bool = True,
+) -> np.ndarray:
+    r"""Mean number of rearrangements per thermal time tau_th (eq. ``slope``).
+
+    With ``offset=True`` this is the paper's phenomenological form
+
+    .. math:: \langle r \rangle = \frac{\sigma_\theta - \mu_d \tilde N}
+              {\sqrt{\pi}\,(\bar\mu_s - \mu_d)\,\tilde N},
+
+    and with ``offset=False`` the plain estimate without the shift
+    :math:`\mu_d \tilde N`. Both are approximations: MODEL.md (section 4)
+    says the first fails when ``sigma_theta`` is below about
+    ``2 * mu_d * Ntilde``, and it turns negative, hence meaningless, below
+    ``mu_d * Ntilde``. The value is returned as the formula gives it, without
+    clipping, so that such a misuse shows.
+
+    Parameters
+    ----------
+    sigma_theta : float or array_like
+        Standard deviation of the dilation theta (dimensionless), > 0; any shape.
+    Ntilde : float
+        N / (k l0), > 0.
+    mu_d : float
+        Dynamic friction coefficient, finite.
+    mu_s_mean : float
+        Mean static friction coefficient (of p(mu_s) before truncation), > mu_d.
+    offset : bool
+        Subtract the offset mu_d * Ntilde of eq. ``slope`` (default) or not.
+
+    Returns
+    -------
+    numpy.ndarray
+        <r>, rearrangements per tau_th, with the shape of ``sigma_theta``.
+
+    Raises
+    ------
+    ConfigError
+        On a non-finite or non-positive ``sigma_theta`` or ``Ntilde``, a
+        non-finite ``mu_d``, or ``mu_s_mean <= mu_d``.
+
+    Examples
+    --------
+    >>> r = mean_rearrangements(1e-6, Ntilde=1e-7, mu_d=0.5, mu_s_mean=0.6)
+    >>> round(float(r), 2)
+    53.6
+    >>> round(float(mean_rearrangements(1e-6, 1e-7, 0.5, 0.6, offset=False)), 2)
+    56.42
+    """
+    owner = "mean_rearrangements"
+    sigma = _check_positive(sigma_theta, "sigma_theta", owner)
+    ntilde = float(_check_positive(Ntilde, "Ntilde", owner))
+    mu_d = float(_check_finite(mu_d, "mu_d", owner))
+    mu_s_mean = float(_check_finite(mu_s_mean, "mu_s_mean", owner))
+    if not mu_s_mean > mu_d:
+        raise param_error("mu_s_mean", owner, f"> mu_d = {mu_d!r}", mu_s_mean)
+    shift = mu_d * ntilde if offset else 0.0
+    return (sigma - shift) / (math.sqrt(math.pi) * (mu_s_mean - mu_d) * ntilde)
+
+
+# ---------------------------------------------------------------------------
+# statistics of mu_max (exact)
+
+
+def mu_max_cdf(dist: Any, mu: ArrayLike, n: ArrayLike) -> np.ndarray:
+    r"""Exact CDF of mu_max after ``n`` rearrangements: :math:`F(\mu)^{n+2}`.
+
+    In the two-slider model only the weaker threshold is ever redrawn, so
+    mu_max is the maximum of the ``n + 2`` independent draws (two initial
+    ones and one per rearrangement; MODEL.md, section 4).
+
+    Parameters
+    ----------
+    dist : object
+        The distribution of mu_s as the model draws it, i.e. already
+        truncated below mu_d (e.g. :class:`~slidernet.distributions.TruncatedBelow`).
+        Needs ``cdf``; ``sf`` is used when present, which keeps the result
+        accurate in the upper tail for ``n`` up to 1e9 and beyond.
+    mu : float or array_like
+        Friction coefficient(s) at which to evaluate the CDF.
+    n : float or array_like
+        Number of rearrangements, >= 0; broadcast against ``mu``.
+
+    Returns
+    -------
+    numpy.ndarray
+        P(mu_max <= mu), shape ``np.broadcast(mu, n).shape``.
+
+    Examples
+    --------
+    >>> from slidernet.distributions import Gaussian
+    >>> d = Gaussian(0.6, 0.01)
+    >>> float(mu_max_cdf(d, 0.6, 0))
+    0.25
+    >>> mu_max_cdf(d, [0.6, 0.7], [[0], [1]]).shape
+    (2, 2)
+    """
+    owner = "mu_max_cdf"
+    _check_dist(dist, owner)
+    m = _check_count(n, owner) + 2.0
+    mu = _as_float_array(mu, "mu", owner)
+    return np.exp(m * _log_cdf(dist, mu))
+
+
+def _bracket(dist: Any, eps_lo: float, eps_hi: float) -> tuple[float, float]:
+    """Points a < b with F(a) <= eps_lo and 1 - F(b) <= eps_hi."""
+    lower = getattr(dist, "lower", None)
+    lower = None if lower is None else float(lower)
+    centre = 0.0 if lower is None else lower
+    width = 1.0
+    a = centre if lower is not None else centre - width
+    b = centre + width
+    # Doubling reaches any finite support from an arbitrary starting scale;
+    # 1100 doublings would overflow, so stop well before that.
+    for _ in range(1000):
+        low_ok = lower is not None or float(np.exp(_log_cdf(dist, np.array(a)))) <= eps_lo
+        high_ok = -math.expm1(float(_log_cdf(dist, np.array(b)))) <= eps_hi
+        if low_ok and high_ok:
+            return a, b
+        width *= 2.0
+        if not low_ok:
+            a = centre - width
+        if not high_ok:
+            b = centre + width
+    raise ConfigError(
+        f"mu_max_moments could not bracket the support of {dist!r}: its cdf does not "
+        "reach 0 and 1 within |x| < 1e300."
+    )
+
+
+def _bisect(pred: Any, a: float, b: float, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Vectorised bisection: pred(x) is True at ``a``, False at ``b``, monotone.
+
+    Returns the final (lo, hi) arrays; lo still satisfies the predicate.
+    """
+    lo = np.full(size, a)
+    hi = np.full(size, b)
+    # 2100 halvings shrink any double interval to adjacent floats; stop early
+    # once no midpoint differs from its ends.
+    for _ in range(2100):
+        mid = 0.5 * (lo + hi)
+        moving = (mid > lo) & (mid < hi)
+        if not moving.any():
+            break
+        ok = pred(mid)
+        lo = np.where(ok & moving, mid, lo)
+        hi = np.where(~ok & moving, mid, hi)
+    return lo, hi
+
+
+def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    r"""Exact mean and standard deviation of mu_max after ``n`` rearrangements.
+
+    mu_max is the maximum of ``m = n + 2`` independent draws (see
+    :func:`mu_max_cdf`). The moments are integrals of the distribution's own
+    CDF -- no Monte Carlo, no asymptotic expansion:
+
+    .. math:: E[X] = x_\mathrm{lo} + \int_{x_\mathrm{lo}}^{x_\mathrm{hi}} (1 - F^m)\,dx,
+              \qquad
+              E[(X - x_\mathrm{lo})^2] = \int_{x_\mathrm{lo}}^{x_\mathrm{hi}}
+              2 (x - x_\mathrm{lo}) (1 - F^m)\,dx,
+
+    where :math:`F(x_\mathrm{lo})^m \approx 10^{-17}` (or ``x_lo = dist.lower``
+    when the distribution has that attribute and it is higher) and
+    :math:`1 - F(x_\mathrm{hi})^m \approx 10^{-17}`, both found by vectorised
+    bisection, and the integrals use 2000-point Gauss-Legendre quadrature.
+    The error is at the level of double-precision rounding (about 1e-12
+    standard deviations of p(mu_s)) for any ``n`` from 0 to 1e9 and beyond,
+    provided ``dist`` has ``sf``; with ``cdf`` only, the tail 1 - F below
+    ~1e-16 is lost, which still leaves errors far below 1e-4 standard
+    deviations up to n = 1e9. The distribution must have a finite mean.
+
+    Parameters
+    ----------
+    dist : object
+        The distribution of mu_s as the model draws it (truncated below
+        mu_d), with ``cdf`` and optionally ``sf`` and ``lower``.
+    n : float or array_like
+        Number(s) of rearrangements, >= 0, any shape. Repeated values are
+        computed once.
+
+    Returns
+    -------
+    mean, std : numpy.ndarray
+        Mean and standard deviation of mu_max, each with the shape of ``n``.
+
+    Examples
+    --------
+    >>> from slidernet.distributions import Gaussian, TruncatedBelow
+    >>> d = TruncatedBelow(Gaussian(0.6, 0.01), lower=0.5, name="gaussian")
+    >>> mean, std = mu_max_moments(d, [0, 1000])
+    >>> mean.round(5).tolist(), std.round(5).tolist()
+    ([0.60564, 0.63241], [0.00826, 0.00429])
+    """
+    owner = "mu_max_moments"
+    _check_dist(dist, owner)
+    n_arr = _check_count(n, owner)
+    m_unique, inverse = np.unique(n_arr.ravel() + 2.0, return_inverse=True)
+    m = m_unique[:, None]
+    log_eps_lo = math.log(_TAIL_EPS)
+
+    def below_lo(x: np.ndarray) -> np.ndarray:
+        # F^m <= eps, written in logs so that F^m never underflows.
+        return m[:, 0] * _log_cdf(dist, x) <= log_eps_lo
+
+    def above_hi(x: np.ndarray) -> np.ndarray:
+        return -np.expm1(m[:, 0] * _log_cdf(dist, x)) <= _TAIL_EPS
+
+    # The loosest targets of the whole batch (the smallest m at the bottom,
+    # the largest at the top) bound a bracket valid for every m.
+    eps_lo = math.exp(log_eps_lo / m_unique[0])
+    eps_hi = -math.expm1(math.log1p(-_TAIL_EPS) / m_unique[-1])
+    a, b = _bracket(dist, eps_lo, eps_hi)
+    x_lo, _ = _bisect(below_lo, a, b, m_unique.size)
+    _, x_hi = _bisect(lambda x: ~above_hi(x), a, b, m_unique.size)
+    # A step in F makes the bisection meet itself; keep a nonempty range.
+    x_hi = np.maximum(x_hi, x_lo)
+
+    nodes, weights = np.polynomial.legendre.leggauss(_N_NODES)
+    half = 0.5 * (x_hi - x_lo)[:, None]
+    x = x_lo[:, None] + half * (nodes + 1.0)
+    survival = -np.expm1(m * _log_cdf(dist, x))  # P(max > x)
+    w = half * weights
+    above = (w * survival).sum(axis=1)  # E[X] - x_lo
+    second = (w * 2.0 * (x - x_lo[:, None]) * survival).sum(axis=1)  # E[(X - x_lo)^2]
+    mean = x_lo + above
+    var = np.maximum(second - above**2, 0.0)
+    shape = n_arr.shape
+    return mean[inverse].reshape(shape), np.sqrt(var)[inverse].reshape(shape)
+
+
+def mu_max_leading(mu_s_mean: float, sigma_mu: float, n: ArrayLike) -> np.ndarray:
+    r"""Leading-order growth of mu_max (eq. ``mumaxth``).
+
+    .. math:: \mu_\mathrm{max} \approx \bar\mu_s + \sigma_\mu \sqrt{2 \ln n}
+
+    This is only the leading term of the extreme-value asymptotics of a
+    Gaussian: it overestimates the exact mean maximum
+    (:func:`mu_max_moments`) by 0.4 to 0.5 ``sigma_mu`` for n = 1e3 to 1e6,
+    and the correction decays only like ln(ln n) / sqrt(ln n). Where n <= 1
+    the logarithm is not positive and ``mu_s_mean`` is returned; the law
+    carries no information there.
+
+    Parameters
+    ----------
+    mu_s_mean : float
+        Mean static friction coefficient, finite.
+    sigma_mu : float
+        Standard deviation of mu_s, > 0.
+    n : float or array_like
+        Number of rearrangements, >= 0 (in the paper, ``<r> t / tau_th``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Predicted mu_max, shape of ``n``.
+
+    Examples
+    --------
+    >>> mu_max_leading(0.6, 0.01, [1, 1e4]).round(4).tolist()
+    [0.6, 0.6429]
+    """
+    owner = "mu_max_leading"
+    mu_s_mean = float(_check_finite(mu_s_mean, "mu_s_mean", owner))
+    sigma_mu = float(_check_positive(sigma_mu, "sigma_mu", owner))
+    n_arr = _check_count(n, owner)
+    log_n = np.log(np.maximum(n_arr, 1.0))
+    return mu_s_mean + sigma_mu * np.sqrt(2.0 * log_n)
+
+
+# ---------------------------------------------------------------------------
+# diffusion and records
+
+
+def msd(sigma_theta: ArrayLike, n: ArrayLike) -> np.ndarray:
+    r"""Order-of-magnitude law of the centre-of-mass diffusion.
+
+    .. math:: \langle x_G^2 \rangle \approx \sigma_\theta^2\, l_0^2 \ln n
+
+    (the paper's section IV.C): each exchange of the strongest slider moves
+    the centre of mass by about sigma_theta l0, and there are about ln n
+    exchanges. Only the order of magnitude and the logarithmic growth are
+    claimed; see :func:`mean_records` for the exact number of exchanges.
+    Returns 0 where n <= 1.
+
+    Parameters
+    ----------
+    sigma_theta : float or array_like
+        Standard deviation of the dilation theta, > 0.
+    n : float or array_like
+        Number of rearrangements, >= 0; broadcast against ``sigma_theta``.
+
+    Returns
+    -------
+    numpy.ndarray
+        <x_G^2> in units of l0^2, shape ``np.broadcast(sigma_theta, n).shape``.
+
+    Examples
+    --------
+    >>> float(msd(1e-6, 1.0))
+    0.0
+    >>> round(float(msd(1e-6, np.e**2)) / 1e-12, 12)
+    2.0
+    """
+    owner = "msd"
+    sigma = _check_positive(sigma_theta, "sigma_theta", owner)
+    n_arr = _check_count(n, owner)
+    return sigma**2 * np.log(np.maximum(n_arr, 1.0))
+
+
+def harmonic(n: ArrayLike) -> np.ndarray:
+    r"""Harmonic number :math:`H_n = \sum_{k=1}^{n} 1/k`, vectorised.
+
+    Integer n up to 1024 come from an exact rational table (correctly
+    rounded); larger or non-integer n use the analytic continuation
+    :math:`H_n = \psi(n + 1) + \gamma`, accurate to a few ulp.
+
+    Parameters
+    ----------
+    n : int, float or array_like
+        n >= 0, any shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        H_n, float, shape of ``n``.
+
+    Examples
+    --------
+    >>> harmonic([0, 1, 2, 3]).tolist() == [0.0, 1.0, 1.5, 11 / 6]
+    True
+    >>> round(float(harmonic(1e9)), 6)
+    21.300482
+    """
+    n_arr = _check_count(n, "harmonic")
+    small = (n_arr == np.floor(n_arr)) & (n_arr <= _H_TABLE_MAX)
+    index = np.where(small, n_arr, 0).astype(np.intp)
+    return np.where(small, _H_TABLE[index], special.digamma(n_arr + 1.0) + np.euler_gamma)
+
+
+def mean_records(n: ArrayLike) -> np.ndarray:
+    r"""Expected number of exchanges of the strongest slider after n rearrangements.
+
+    The k-th draw (k >= 3; the first two are the initial thresholds) makes
+    the other slider the strongest exactly when it exceeds every earlier
+    draw, i.e. when it is a strict record, which has probability 1/k for
+    i.i.d. continuous draws. Hence, exactly,
+
+    .. math:: \langle \text{exchanges} \rangle = \sum_{k=3}^{n+2} \frac1k
+              = H_{n+2} - H_2 = H_{n+2} - \tfrac32 .
+
+    MODEL.md's "mean H_n" (and the paper's "ln n") is the leading-order
+    form of this: H_{n+2} - 3/2 = ln n + gamma - 3/2 + O(1/n), so the two
+    differ by about 0.92 for large n.
+
+    Parameters
+    ----------
+    n : int, float or array_like
+        Number of rearrangements, >= 0, any shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        Mean number of exchanges (records), shape of ``n``.
+
+    Examples
+    --------
+    >>> mean_records([0, 1, 2]).tolist() == [0.0, 1 / 3, 1 / 3 + 1 / 4]
+    True
+    """
+    n_arr = _check_count(n, "mean_records")
+    return harmonic(n_arr + 2.0) - 1.5
