@@ -144,96 +144,163 @@ def _refill(buf: np.ndarray, pos: int, fresh: np.ndarray) -> np.ndarray:
     return np.concatenate([buf[pos:], fresh])
 
 
-def simulate(scene: Scene, seed_seq: np.random.SeedSequence) -> dict[str, np.ndarray]:
-    """Run one realization; return its records at ``scene.rec_times``.
+class Realization:
+    """One realization: its random streams, its state and its records.
 
-    Returns
-    -------
-    dict of str to ndarray
-        ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
-        (T,), and the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
-        record bin, shape (T,), where T = ``scene.rec_times.size``.
+    Constructing it draws theta(t_q) and the initial thresholds; work happens
+    in :meth:`advance`. Between calls the state is fully relaxed (every node
+    stable), which the property tests check through :meth:`forces`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, shared by all realizations.
+    seed_seq : numpy.random.SeedSequence
+        This realization's own seed (a child of the run's seed).
     """
-    rngs = realization_streams(seed_seq)
-    net = scene.network
-    Ntilde = net.Ntilde
-    thetas = draw_thetas(scene, rngs["driver"]) / Ntilde
-    dist = scene.distribution
-    mu = dist.sample(rngs["thresholds"], net.n_nodes).astype(np.float64)
-    mu_buf = dist.sample(rngs["thresholds"], scene.batch)
-    if scene.do_tilt:
-        tmu = dist.sample(rngs["tilt"], scene.batch)
-        tu = rngs["tilt"].random(scene.batch)
-    else:
-        tmu = np.empty(0)
-        tu = np.empty(0)
 
-    T = scene.rec_times.size
-    out = {
-        "n": np.zeros(T, np.int64),
-        "mu_max": np.zeros(T),
-        "x_G": np.zeros(T),
-        "n_records": np.zeros(T, np.int64),
-        "f_sum": np.zeros(T),
-        "f_sq": np.zeros(T),
-        "f_count": np.zeros(T, np.int64),
-    }
-    ist, fst = kernels.empty_state()
-    fst[kernels.THETA] = thetas[0]
-    fst[kernels.U] = thetas[0]  # the spring at rest at theta(0): u = theta(0)
-    fst[kernels.MU_MAX] = mu.max()
-    ist[kernels.ARGMAX] = int(np.argmax(mu))
-
-    c = scene.csr
-    if scene.kernel == "csr":
-        # a = F - theta g with u = 0: every spring at rest at theta(0).
-        a = -c["g"] * thetas[0]
-        u = np.zeros(net.n_nodes)
-        heap = np.zeros(net.n_nodes, np.int64)
-        pos = np.full(net.n_nodes, -1, np.int64)
-        key = np.zeros(net.n_nodes)
-
-    while True:
-        if scene.kernel == "pair":
-            status = kernels.run_pair(
-                thetas, scene.rec_times, mu, ist, fst, mu_buf, tmu, tu, scene.mu_d,
-                scene.do_tilt, scene.max_avalanche, out["n"], out["mu_max"], out["x_G"],
-                out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
-            )
+    def __init__(self, scene: Scene, seed_seq: np.random.SeedSequence) -> None:
+        self.scene = scene
+        self.rngs = realization_streams(seed_seq)
+        net = scene.network
+        self.thetas = draw_thetas(scene, self.rngs["driver"]) / net.Ntilde
+        dist = scene.distribution
+        self.mu = dist.sample(self.rngs["thresholds"], net.n_nodes).astype(np.float64)
+        self.mu_buf = dist.sample(self.rngs["thresholds"], scene.batch)
+        if scene.do_tilt:
+            self.tmu = dist.sample(self.rngs["tilt"], scene.batch)
+            self.tu = self.rngs["tilt"].random(scene.batch)
         else:
-            status = kernels.run_csr(
-                thetas, scene.rec_times, mu, ist, fst, a, u, mu_buf, tmu, tu, scene.mu_d,
-                scene.do_tilt, scene.max_avalanche, c["indptr"], c["indices"], c["kdata"],
-                c["kdiag"], c["g"], c["normal_load"], c["w"], c["driven"], heap, pos, key,
-                out["n"], out["mu_max"], out["x_G"], out["n_records"], out["f_sum"],
-                out["f_sq"], out["f_count"],
+            self.tmu = np.empty(0)
+            self.tu = np.empty(0)
+        T = scene.rec_times.size
+        self.out = {
+            "n": np.zeros(T, np.int64),
+            "mu_max": np.zeros(T),
+            "x_G": np.zeros(T),
+            "n_records": np.zeros(T, np.int64),
+            "f_sum": np.zeros(T),
+            "f_sq": np.zeros(T),
+            "f_count": np.zeros(T, np.int64),
+        }
+        self.ist, self.fst = kernels.empty_state()
+        self.fst[kernels.THETA] = self.thetas[0]
+        self.fst[kernels.U] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
+        self.fst[kernels.MU_MAX] = self.mu.max()
+        self.ist[kernels.ARGMAX] = int(np.argmax(self.mu))
+        if scene.kernel == "csr":
+            # a = F - theta g with u = 0: every spring at rest at theta(0).
+            self.a = -scene.csr["g"] * self.thetas[0]
+            self.u = np.zeros(net.n_nodes)
+            self.heap = np.zeros(net.n_nodes, np.int64)
+            self.pos = np.full(net.n_nodes, -1, np.int64)
+            self.key = np.zeros(net.n_nodes)
+
+    @property
+    def step(self) -> int:
+        """The number of thermal steps done so far."""
+        return int(self.ist[kernels.Q])
+
+    @property
+    def n(self) -> int:
+        """Cumulative number of rearrangements."""
+        return int(self.ist[kernels.N_SLIPS])
+
+    @property
+    def thresholds(self) -> np.ndarray:
+        """Current mu_s of every node, shape (N,)."""
+        return self.mu.copy()
+
+    @property
+    def theta(self) -> float:
+        """Current dilation theta (dimensionless)."""
+        return float(self.fst[kernels.THETA] * self.scene.network.Ntilde)
+
+    @property
+    def x_G(self) -> float:
+        """Current centre-of-mass displacement, in l0."""
+        return float(self.fst[kernels.XG] * self.scene.network.Ntilde)
+
+    def forces(self) -> np.ndarray:
+        """Spring forces on every node, in units of N, shape (N,)."""
+        theta = self.fst[kernels.THETA]
+        if self.scene.kernel == "pair":
+            F = theta - self.fst[kernels.U]
+            return np.array([-F, F])
+        return self.a + self.scene.csr["g"] * theta
+
+    def _call_kernel(self, thetas: np.ndarray) -> int:
+        sc, c, out = self.scene, self.scene.csr, self.out
+        if sc.kernel == "pair":
+            return kernels.run_pair(
+                thetas, sc.rec_times, self.mu, self.ist, self.fst, self.mu_buf, self.tmu,
+                self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, out["n"], out["mu_max"],
+                out["x_G"], out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
             )
-        if status == kernels.DONE:
-            break
-        if status == kernels.NEED_MU:
-            mu_buf = _refill(mu_buf, ist[kernels.MU_POS],
-                             dist.sample(rngs["thresholds"], scene.batch))
-            ist[kernels.MU_POS] = 0
-        elif status == kernels.NEED_TILT:
-            tmu = _refill(tmu, ist[kernels.TMU_POS], dist.sample(rngs["tilt"], scene.batch))
-            tu = _refill(tu, ist[kernels.TU_POS], rngs["tilt"].random(scene.batch))
-            ist[kernels.TMU_POS] = 0
-            ist[kernels.TU_POS] = 0
-        elif status == kernels.AVALANCHE_LIMIT:
-            i = int(ist[kernels.ERR_NODE])
-            theta = fst[kernels.THETA] * Ntilde
-            raise AvalancheError(
-                f"An avalanche did not end after {scene.max_avalanche} slips "
-                f"(solver.max_avalanche) during step {ist[kernels.Q]}: node {i} is still "
-                f"unstable with mu_s = {mu[i]!r} at theta = {theta!r}."
-            )
-        elif status == kernels.TILT_LIMIT:
-            raise TiltTestError(
-                f"The tilt test did not reach sliding within {kernels.TILT_MAX_ITER} "
-                f"iterations at step {ist[kernels.Q]}."
-            )
-        else:  # pragma: no cover - a new status code without a handler is a bug
-            raise RuntimeError(f"unknown kernel status {status}")
-    out["x_G"] *= Ntilde
-    out["n_events"] = np.int64(ist[kernels.N_EVENTS])
-    return out
+        return kernels.run_csr(
+            thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
+            self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, c["indptr"],
+            c["indices"], c["kdata"], c["kdiag"], c["g"], c["normal_load"], c["w"],
+            c["driven"], self.heap, self.pos, self.key, out["n"], out["mu_max"], out["x_G"],
+            out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
+        )
+
+    def advance(self, to_step: int | None = None) -> Realization:
+        """Run the thermal steps up to ``to_step`` (default: the last one)."""
+        sc = self.scene
+        to_step = sc.steps if to_step is None else int(to_step)
+        if not self.step <= to_step <= sc.steps:
+            raise ValueError(f"to_step must lie in [{self.step}, {sc.steps}]; got {to_step}")
+        # The kernel stops at the end of the array it is given.
+        thetas = self.thetas[: to_step + 1]
+        dist = sc.distribution
+        ist = self.ist
+        while True:
+            status = self._call_kernel(thetas)
+            if status == kernels.DONE:
+                return self
+            if status == kernels.NEED_MU:
+                self.mu_buf = _refill(self.mu_buf, ist[kernels.MU_POS],
+                                      dist.sample(self.rngs["thresholds"], sc.batch))
+                ist[kernels.MU_POS] = 0
+            elif status == kernels.NEED_TILT:
+                self.tmu = _refill(self.tmu, ist[kernels.TMU_POS],
+                                   dist.sample(self.rngs["tilt"], sc.batch))
+                self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt"].random(sc.batch))
+                ist[kernels.TMU_POS] = 0
+                ist[kernels.TU_POS] = 0
+            elif status == kernels.AVALANCHE_LIMIT:
+                i = int(ist[kernels.ERR_NODE])
+                raise AvalancheError(
+                    f"An avalanche did not end after {sc.max_avalanche} slips "
+                    f"(solver.max_avalanche) during step {ist[kernels.Q]}: node {i} is still "
+                    f"unstable with F = {self.forces()[i]!r} N, mu_s = {self.mu[i]!r}, "
+                    f"theta = {self.theta!r}."
+                )
+            elif status == kernels.TILT_LIMIT:
+                raise TiltTestError(
+                    f"The tilt test did not reach sliding within {kernels.TILT_MAX_ITER} "
+                    f"iterations at step {ist[kernels.Q]}."
+                )
+            else:  # pragma: no cover - a new status code without a handler is a bug
+                raise RuntimeError(f"unknown kernel status {status}")
+
+    def result(self) -> dict[str, np.ndarray]:
+        """The records at ``scene.rec_times`` (x_G converted to l0).
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
+            (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
+            record bin, shape (T,), and the scalar ``n_events``.
+        """
+        res = {k: v.copy() for k, v in self.out.items()}
+        res["x_G"] *= self.scene.network.Ntilde
+        res["n_events"] = np.int64(self.ist[kernels.N_EVENTS])
+        return res
+
+
+def simulate(scene: Scene, seed_seq: np.random.SeedSequence) -> dict[str, np.ndarray]:
+    """Run one whole realization; see :meth:`Realization.result` for the records."""
+    return Realization(scene, seed_seq).advance().result()

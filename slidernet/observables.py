@@ -1,0 +1,104 @@
+"""From per-realization records to the result dataset (MODEL.md section 3).
+
+Per realization (dims ``realization, t``): ``n``, ``mu_max``, ``x_G`` and
+``n_records``. Ensemble statistics (dim ``t``): ``<name>_mean`` and
+``<name>_sem`` (standard error of the mean over realizations), ``x_G2_mean``
+(the mean square displacement) and ``mu_eff`` from the virtual tilt test.
+
+mu_eff(t_k) pools every tilt test made at the rearrangements of the bin
+(t_{k-1}, t_k] over all realizations (the appendix's average). The bin of
+t = 0 holds one test per realization, made on the initial state, so that
+mu_eff(0) is the value of a fresh system. A bin without any rearrangement
+gives NaN, with ``mu_eff_count = 0``. Its standard error treats the
+realizations as independent clusters of correlated samples.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+ATTRS = {
+    "n": {"long_name": "cumulative number of rearrangements (slips)", "units": "1"},
+    "mu_max": {"long_name": "largest static threshold mu_s in the network", "units": "1"},
+    "x_G": {"long_name": "centre-of-mass displacement along x since t = 0", "units": "l0"},
+    "n_records": {"long_name": "number of drawn thresholds that exceeded the running mu_max",
+                  "units": "1"},
+    "mu_eff": {"long_name": "effective static friction coefficient from the virtual tilt test",
+               "units": "1"},
+}
+
+
+def _sem(x: np.ndarray) -> np.ndarray:
+    """Standard error over axis 0; NaN with a single realization (undefined)."""
+    R = x.shape[0]
+    if R < 2:
+        return np.full(x.shape[1:], np.nan)
+    return x.std(axis=0, ddof=1) / np.sqrt(R)
+
+
+def assemble(
+    records: list[dict[str, np.ndarray]],
+    t: np.ndarray,
+    observables: list[str],
+    attrs: dict[str, str | int | float],
+) -> xr.Dataset:
+    """Stack the realizations' records into the result dataset.
+
+    Parameters
+    ----------
+    records : list of dict
+        One dict per realization, in realization order, as returned by
+        :func:`slidernet.solver.simulate`.
+    t : ndarray of int, shape (T,)
+        Recorded times in tau_th.
+    observables : list of str
+        The requested observables; ``mu_eff`` adds the tilt-test variables.
+    attrs : dict
+        Global attributes (resolved config, version, seed).
+
+    Returns
+    -------
+    xarray.Dataset
+        Coordinates ``realization`` and ``t``; see the module docstring.
+    """
+    R = len(records)
+    coords = {"realization": np.arange(R), "t": np.asarray(t, dtype=np.int64)}
+    ds = xr.Dataset(coords=coords, attrs=dict(attrs))
+    ds["t"].attrs.update(long_name="time", units="tau_th")
+    for name in ("n", "mu_max", "x_G", "n_records"):
+        if name not in observables:
+            continue
+        data = np.stack([r[name] for r in records])
+        ds[name] = (("realization", "t"), data, ATTRS[name])
+        ds[f"{name}_mean"] = ("t", data.mean(axis=0),
+                              {"long_name": f"ensemble mean of {name}", "units": ATTRS[name]["units"]})
+        ds[f"{name}_sem"] = ("t", _sem(data), {"long_name": f"standard error of {name}_mean",
+                                               "units": ATTRS[name]["units"]})
+        if name == "x_G":
+            x2 = data**2
+            ds["x_G2_mean"] = ("t", x2.mean(axis=0),
+                               {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
+            ds["x_G2_sem"] = ("t", _sem(x2),
+                              {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+    if "n" in observables and ds.sizes["t"] > 1:
+        steps = int(t[-1])
+        r = np.array([rec["n"][-1] / steps for rec in records])
+        ds["r_mean"] = ((), r.mean(), {"long_name": "mean rearrangements per tau_th", "units": "1"})
+        ds["r_sem"] = ((), _sem(r[:, None])[0], {"long_name": "standard error of r_mean", "units": "1"})
+    if "mu_eff" in observables:
+        fsum = np.stack([r["f_sum"] for r in records])
+        count = np.stack([r["f_count"] for r in records]).astype(float)
+        total = count.sum(axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mu_eff = fsum.sum(axis=0) / total
+            # Ratio estimator: realizations are independent clusters.
+            cbar = total / R
+            resid = fsum - mu_eff[None, :] * count
+            sem = np.sqrt((resid**2).sum(axis=0) / (R * (R - 1))) / cbar if R > 1 else np.nan * total
+        ds["mu_eff"] = ("t", mu_eff, ATTRS["mu_eff"])
+        ds["mu_eff_sem"] = ("t", np.where(total > 0, sem, np.nan),
+                            {"long_name": "standard error of mu_eff", "units": "1"})
+        ds["mu_eff_count"] = ("t", total.astype(np.int64),
+                              {"long_name": "number of tilt tests pooled into mu_eff", "units": "1"})
+    return ds
