@@ -188,6 +188,22 @@ def test_mu_max_moments_cdf_only_plugin_matches_sf():
     np.testing.assert_allclose(bare[0], mu_max_moments(NARROW, n)[0], rtol=0, atol=1e-8)
 
 
+class CdfOnlyUniform:
+    """Uniform on [0.55, 0.65] with only a cdf: bounded support, no ``lower``."""
+
+    def cdf(self, x: np.ndarray | float) -> np.ndarray:
+        return np.clip((np.asarray(x, dtype=float) - 0.55) / 0.1, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("n", [0, 10, 1e6], ids=lambda n: f"n={n:g}")
+def test_mu_max_moments_uniform_plugin_closed_form(n):
+    # Max of m uniforms on [a, a + w]: mean a + w m/(m+1), var w^2 m/((m+1)^2 (m+2)).
+    m = n + 2
+    mean, std = mu_max_moments(CdfOnlyUniform(), n)
+    assert float(mean) == pytest.approx(0.55 + 0.1 * m / (m + 1), abs=1e-12)
+    assert float(std) == pytest.approx(0.1 * math.sqrt(m / ((m + 1) ** 2 * (m + 2))), rel=1e-6)
+
+
 def test_mu_max_moments_median_gap():
     # mean - median of the max of m Gaussians, with the exact median
     # mu + sigma * isf(1 - 2^(-1/m)), tends to the Gumbel value
@@ -216,6 +232,7 @@ def test_mu_max_moments_shape_monotonicity_and_speed():
     assert grid_mean.shape == (2, 3)
     assert grid_mean[0, 1] == grid_mean[0, 2] == grid_mean[1, 2]
     assert grid_std[0, 0] == grid_std[1, 1]
+    assert mu_max_moments(NARROW, [])[0].shape == (0,)
 
 
 # ---------------------------------------------------------------------------
