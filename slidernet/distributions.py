@@ -21,7 +21,7 @@ import math
 import numpy as np
 from scipy import special
 
-from slidernet.errors import ConfigError, PluginError, param_error
+from slidernet.errors import ConfigError, param_error
 
 
 def _check_finite_positive(value: float, param: str, owner: str) -> float:
@@ -131,15 +131,9 @@ class TruncatedBelow:
         return 1.0 - np.asarray(self.dist.cdf(x), dtype=float)
 
     def _checked(self, draws: object, size: int) -> np.ndarray:
-        arr = np.asarray(draws, dtype=float)
-        if arr.shape != (size,):
-            raise PluginError(
-                f"The distribution {self.name!r} returned shape {arr.shape} from "
-                f"sample(rng, {size}); expected ({size},)."
-            )
-        if not np.isfinite(arr).all():
-            raise PluginError(f"The distribution {self.name!r} returned NaN or inf values.")
-        return arr
+        from slidernet.registry import checked_output
+
+        return checked_output(draws, (size,), "distribution", self.name, f"sample(rng, {size})")
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """``size`` draws strictly above ``lower``, shape ``(size,)``."""

@@ -19,7 +19,9 @@ from collections.abc import Callable
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
-from slidernet.errors import UnknownPluginError
+import numpy as np
+
+from slidernet.errors import PluginError, UnknownPluginError
 
 Factory = Callable[..., Any]
 
@@ -110,6 +112,24 @@ class Registry:
         """Forget discovered entry points (for tests and for newly installed packages)."""
         self._entry_points = None
         self._loaded.clear()
+
+
+def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str, call: str) -> np.ndarray:
+    """A plugin's returned array as float64, refused unless it has ``shape`` and is finite.
+
+    >>> checked_output([1.0, float("nan")], (2,), "driver", "mine", "thetas(rng, 1)")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.PluginError: The driver 'mine' returned NaN or inf values from thetas(rng, 1).
+    """
+    arr = np.asarray(values, dtype=np.float64)
+    if arr.shape != shape:
+        raise PluginError(
+            f"The {kind} {name!r} returned shape {arr.shape} from {call}; expected {shape}."
+        )
+    if not np.isfinite(arr).all():
+        raise PluginError(f"The {kind} {name!r} returned NaN or inf values from {call}.")
+    return arr
 
 
 def _builtin_distributions() -> dict[str, Factory]:

@@ -20,8 +20,9 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.config import Config
-from slidernet.errors import AvalancheError, PluginError, TiltTestError
+from slidernet.errors import AvalancheError, TiltTestError
 from slidernet.network import Network, chain, two_slider
+from slidernet.registry import checked_output
 
 
 def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> np.ndarray:
@@ -127,14 +128,8 @@ def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random
 
 def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
     """theta(t_q) from the driver plugin, checked: shape (steps + 1,), finite."""
-    thetas = np.asarray(scene.driver.thetas(rng, scene.steps), dtype=np.float64)
-    if thetas.shape != (scene.steps + 1,):
-        raise PluginError(
-            f"The driver {scene.driver_name!r} returned shape {thetas.shape} from "
-            f"thetas(rng, {scene.steps}); expected ({scene.steps + 1},)."
-        )
-    if not np.isfinite(thetas).all():
-        raise PluginError(f"The driver {scene.driver_name!r} returned NaN or inf values.")
+    thetas = checked_output(scene.driver.thetas(rng, scene.steps), (scene.steps + 1,), "driver",
+                            scene.driver_name, f"thetas(rng, {scene.steps})")
     return thetas
 
 
