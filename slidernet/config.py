@@ -119,14 +119,14 @@ class Config(_Strict):
     def _check_cross_fields(self) -> Config:
         if isinstance(self.record, list):
             if any(t > self.steps for t in self.record):
-                raise ValueError(f"record times must lie in [0, steps = {self.steps}]")
+                raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         if "mu_eff" in self.observables and self.n_nodes != 2:
             raise ValueError(
                 "the 'mu_eff' observable (the appendix's tilt test) is defined for 2 sliders; "
                 f"this network has {self.n_nodes}"
             )
         if self.solver.kernel == "pair" and self.network.kind == "chain" and self.n_nodes != 2:
-            raise ValueError("solver.kernel = 'pair' needs a 2-slider network")
+            raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
         return self
 
     @property
@@ -185,7 +185,10 @@ def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
 
 
 def _describe(err: Mapping[str, Any]) -> str:
-    loc = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-after"))
+    # Drop pydantic's internal names of union members and validators from the path.
+    loc = ".".join(
+        str(p) for p in err["loc"] if not (str(p).startswith("function-") or "[" in str(p))
+    )
     kind = err["type"]
     ctx = err.get("ctx") or {}
     got = err.get("input")
@@ -204,7 +207,7 @@ def _describe(err: Mapping[str, Any]) -> str:
         return f"The {loc!r} field must be a finite number. Got {got!r} instead."
     if kind == "value_error":
         msg = str(ctx.get("error", err["msg"]))
-        return f"The {loc!r} field: {msg}." if loc else f"{msg[0].upper()}{msg[1:]}."
+        return f"The {loc!r} field: {msg}." if loc else f"Invalid combination: {msg}."
     return f"The {loc!r} field: {err['msg']}. Got {got!r} instead."
 
 
@@ -244,7 +247,8 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
         try:
             cfg = Config.model_validate(dict(source))
         except ValidationError as exc:
-            lines = "\n".join(f"  - {_describe(e)}" for e in exc.errors())
+            # dict.fromkeys: a union reports one error per member, often alike.
+            lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
             raise ConfigError(f"Invalid configuration:\n{lines}") from None
     cfg.distribution()
     cfg.driver_plugin()

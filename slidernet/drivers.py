@@ -37,7 +37,9 @@ class GaussianSteps:
     def __init__(self, sigma_theta: float) -> None:
         sigma_theta = float(sigma_theta)
         if not (math.isfinite(sigma_theta) and sigma_theta > 0):
-            raise param_error("sigma_theta", "gaussian_steps", "> 0", sigma_theta)
+            # NaN fails "> 0" too, but "finite" is then the useful word.
+            requirement = "> 0" if math.isfinite(sigma_theta) else "finite and > 0"
+            raise param_error("sigma_theta", "gaussian_steps", requirement, sigma_theta)
         self.sigma_theta = sigma_theta
 
     def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:

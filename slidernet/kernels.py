@@ -203,16 +203,18 @@ def run_pair(
                 ist[ERR_NODE] = i
                 status = AVALANCHE_LIMIT
                 break
+            # The buffer check comes first: a kernel that returns after the
+            # tilt sample would take it again on re-entry.
+            if p >= nbuf:
+                av -= 1
+                status = NEED_MU
+                break
             if do_tilt:
                 st = _tilt_sample(F, mu0, mu1, mu_d, tmu, tu, ist, k, fsum, fsq, fcount)
                 if st != DONE:
                     av -= 1
                     status = st
                     break
-            if p >= nbuf:
-                av -= 1
-                status = NEED_MU
-                break
         else:
             if q >= steps:
                 break
@@ -234,15 +236,15 @@ def run_pair(
                     thc = th1
                 if s * (theta_b - thc) >= 0.0:
                     theta = thc
+                    if p >= nbuf:
+                        status = NEED_MU
+                        break
                     if do_tilt:
                         st = _tilt_sample(thc - u, mu0, mu1, mu_d, tmu, tu, ist, k,
                                           fsum, fsq, fcount)
                         if st != DONE:
                             status = st
                             break
-                    if p >= nbuf:
-                        status = NEED_MU
-                        break
                     # At theta_c the force on slider i is exactly s_i mu_s,i.
                     aFi = (mu1 if i == 1 else mu0) * 1.0
                     Fi = s * aFi if i == 1 else -s * aFi
@@ -440,15 +442,15 @@ def run_csr(
             if ist[AV_SLIPS] > max_slips:
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
+            if ist[MU_POS] >= mu_buf.size:
+                ist[AV_SLIPS] -= 1
+                return NEED_MU
             if do_tilt:
                 st = _tilt_sample(a[1] + g[1] * theta, mu[0], mu[1], mu_d, tmu, tu, ist,
                                   ist[REC], fsum, fsq, fcount)
                 if st != DONE:
                     ist[AV_SLIPS] -= 1
                     return st
-            if ist[MU_POS] >= mu_buf.size:
-                ist[AV_SLIPS] -= 1
-                return NEED_MU
             _csr_slip(i, Fi, abs(Fi), a, u, mu, indptr, indices, kdata, kdiag, g,
                       normal_load, w, ist, fst, mu_buf, mu_d, heap, pos, key)
         q = ist[Q]
@@ -473,13 +475,13 @@ def run_csr(
                     sigma_best = sigma
             if best >= 0 and s * (theta_b - thc) >= 0.0:
                 fst[THETA] = thc
+                if ist[MU_POS] >= mu_buf.size:
+                    return NEED_MU
                 if do_tilt:
                     st = _tilt_sample(a[1] + g[1] * thc, mu[0], mu[1], mu_d, tmu, tu, ist,
                                       ist[REC], fsum, fsq, fcount)
                     if st != DONE:
                         return st
-                if ist[MU_POS] >= mu_buf.size:
-                    return NEED_MU
                 lim = mu[best] * normal_load[best]
                 ist[AV_SLIPS] = 0
                 ist[N_EVENTS] += 1

@@ -269,8 +269,8 @@ class Realization:
                 raise AvalancheError(
                     f"An avalanche did not end after {sc.max_avalanche} slips "
                     f"(solver.max_avalanche) during step {ist[kernels.Q]}: node {i} is still "
-                    f"unstable with F = {self.forces()[i]!r} N, mu_s = {self.mu[i]!r}, "
-                    f"theta = {self.theta!r}."
+                    f"unstable with F = {float(self.forces()[i])!r} N, "
+                    f"mu_s = {float(self.mu[i])!r}, theta = {self.theta!r}."
                 )
             elif status == kernels.TILT_LIMIT:
                 raise TiltTestError(
