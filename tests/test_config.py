@@ -1,0 +1,236 @@
+"""Configuration: bad input is refused before any work, with a message naming the field."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+import slidernet
+from slidernet import ConfigError, UnknownPluginError, registry
+from slidernet.config import Config, load_config
+from tests.conftest import REFERENCE, make_config
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+# MODEL.md section 5, verbatim.
+REFERENCE_TOML = """\
+seed = 1
+realizations = 200
+steps = 10000                 # thermal steps of duration tau_th
+record = "log"                # recorded times: "log"-spaced or "all"
+observables = ["n", "mu_max", "x_G", "mu_eff"]
+
+[network]
+kind = "two_slider"           # the paper's reference configuration: a 2-node chain
+Ntilde = 1e-7                 # N / (k l0)
+
+[friction]
+mu_d = 0.5
+
+[friction.static]             # a registered distribution of mu_s
+name = "gaussian"
+mean = 0.6
+std = 0.01                    # truncated below mu_d
+
+[driver]                      # a registered temperature driver
+name = "gaussian_steps"
+sigma_theta = 1e-6
+"""
+
+# (dotted key, bad value, pattern the message must match). Each pattern names
+# the field and says what is wrong.
+BAD_VALUES = [
+    ("network.Ntilde", -1e-7, r"'network\.Ntilde' field must be > 0"),
+    ("network.Ntilde", math.nan, r"'network\.Ntilde' field must be a finite number"),
+    ("network.Ntilde", 0.0, r"'network\.Ntilde' field must be > 0"),
+    ("friction.mu_d", -0.5, r"'friction\.mu_d' field must be > 0"),
+    ("friction.mu_d", math.nan, r"'friction\.mu_d' field must be a finite number"),
+    ("driver.sigma_theta", -1e-6, r"'driver' field: The 'sigma_theta' parameter of gaussian_steps must be > 0"),
+    ("driver.sigma_theta", math.nan, r"'sigma_theta' parameter of gaussian_steps must be finite and > 0\. Got nan"),
+    ("friction.static.std", -0.01, r"'friction\.static' field: The 'std' parameter of gaussian must be finite"),
+    ("friction.static.std", math.nan, r"'std' parameter of gaussian must be finite and > 0\. Got nan"),
+    ("friction.static.mean", math.nan, r"'mean' parameter of gaussian must be finite\. Got nan"),
+    ("friction.static.mean", 0.5, r"'mean' parameter of gaussian must be > mu_d = 0\.5\. Got 0\.5"),
+    ("friction.static.mean", 0.4, r"'mean' parameter of gaussian must be > mu_d = 0\.5\. Got 0\.4"),
+    ("realizations", 0, r"'realizations' field must be >= 1\. Got 0"),
+    ("steps", 0, r"'steps' field must be >= 1\. Got 0"),
+    ("steps", -5, r"'steps' field must be >= 1"),
+    ("seed", -1, r"'seed' field must be >= 0"),
+    ("solver.batch", 4, r"'solver\.batch' field must be >= 16"),
+    ("solver.kernel", "gpu", r"'solver\.kernel' field: Input should be 'auto', 'pair' or 'csr'"),
+    ("observables", ["n", "energy"], r"'observables\.1' field: .*'mu_eff'"),
+    ("foo", 1, r"Unknown key 'foo'\."),
+    ("network.foo", 1, r"Unknown key 'foo' in \[network\]"),
+    ("solver.foo", 1, r"Unknown key 'foo' in \[solver\]"),
+    ("friction.foo", 1, r"Unknown key 'foo' in \[friction\]"),
+    ("network.kind", "chain", r"'network' field: a chain needs 'n'"),
+    ("network.n", 3, r"'network' field: two_slider has n = 2 sliders; got n = 3"),
+    ("record", [0, 5, 10001], r"'record' times must lie in \[0, steps = 10000\]"),
+    ("friction.static.shape", 2.0, r"'friction\.static' field: the distribution 'gaussian' does not accept "
+                                   r"\['mean', 'shape', 'std'\].*Its parameters are 'mean', 'std'"),
+    ("driver.period", 2.0, r"'driver' field: the driver 'gaussian_steps' does not accept .*'period'"
+                           r".*Its parameters are 'sigma_theta'"),
+    ("friction.static.std", None, r"'friction\.static' field: the distribution 'gaussian' does not accept"),
+]
+BAD_IDS = [f"{key}={value!r}" for key, value, _ in BAD_VALUES]
+
+
+@pytest.mark.parametrize(("key", "value", "match"), BAD_VALUES, ids=BAD_IDS)
+def test_bad_values_are_refused_naming_the_field(key, value, match):
+    cfg = make_config(**{key: value})
+    if value is None:  # a removed key: the parameter is missing
+        assert key.rsplit(".", 1)[-1] not in cfg["friction"]["static"]
+    with pytest.raises(ConfigError, match=match):
+        load_config(cfg)
+
+
+@pytest.mark.parametrize(
+    ("key", "name", "available"),
+    [("friction.static.name", "weibull", "'gaussian'"), ("driver.name", "sine", "'gaussian_steps'")],
+    ids=["distribution", "driver"],
+)
+def test_unknown_plugin_lists_the_available_ones(key, name, available, clean_registries):
+    with pytest.raises(UnknownPluginError, match=rf"Unknown \w+ '{name}'\. Available: {available}\."):
+        load_config(make_config(**{key: name}))
+
+
+def test_missing_sections_are_all_reported_at_once():
+    with pytest.raises(ConfigError) as info:
+        load_config({"steps": 10})
+    msg = str(info.value)
+    for section in ("network", "friction", "driver"):
+        assert f"The '{section}' field is required." in msg
+
+
+def test_mu_eff_needs_two_sliders():
+    cfg = make_config(network={"kind": "chain", "n": 5, "Ntilde": 1e-7})
+    assert "mu_eff" in cfg["observables"]
+    with pytest.raises(ConfigError, match=r"'mu_eff' observable .* 2 sliders; this network has 5"):
+        load_config(cfg)
+    # Without mu_eff the same chain is fine.
+    cfg["observables"] = ["n", "mu_max", "x_G"]
+    assert load_config(cfg).n_nodes == 5
+
+
+def test_pair_kernel_needs_two_sliders():
+    cfg = make_config(network={"kind": "chain", "n": 3, "Ntilde": 1e-7}, observables=["n"],
+                      **{"solver.kernel": "pair"})
+    with pytest.raises(ConfigError, match=r"'solver\.kernel' value 'pair' needs a 2-slider network"):
+        load_config(cfg)
+
+
+def test_not_a_mapping_is_refused():
+    with pytest.raises(ConfigError, match="must be a dict, a Config or a path; got list"):
+        load_config([("steps", 10)])
+
+
+class SpyDriver:
+    """A driver that counts its uses: a refused config must never reach it."""
+
+    built = 0
+    calls = 0
+
+    def __init__(self, sigma_theta: float) -> None:
+        type(self).built += 1
+
+    def thetas(self, rng, steps):  # pragma: no cover - must not run
+        type(self).calls += 1
+        return np.zeros(steps + 1)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("steps", 0), ("record", [0, 20]), ("friction.static.mean", 0.5), ("network.foo", 1)],
+    ids=["steps", "record", "mean", "unknown-key"],
+)
+def test_refused_before_any_work(key, value, clean_registries):
+    # run() validates everything before it draws a single theta.
+    SpyDriver.built = SpyDriver.calls = 0
+    registry.register_driver("spy", SpyDriver)
+    cfg = make_config(**{"steps": 10, "realizations": 2, "driver.name": "spy", key: value})
+    with pytest.raises(ConfigError):
+        slidernet.run(cfg)
+    assert SpyDriver.calls == 0
+    # Sanity: the same config without the bad value does run the driver.
+    good = make_config(steps=10, realizations=2, observables=["n"], **{"driver.name": "spy"})
+    slidernet.run(good)
+    assert SpyDriver.calls == 2
+
+
+def test_defaults_are_filled_in():
+    cfg = load_config({k: v for k, v in REFERENCE.items() if k in ("steps", "network", "friction", "driver")})
+    assert isinstance(cfg, Config)
+    assert (cfg.seed, cfg.realizations, cfg.record) == (None, 1, "log")
+    assert cfg.observables == ["n", "mu_max", "x_G"]
+    assert (cfg.solver.kernel, cfg.network.kind) == ("auto", "two_slider")
+
+
+# --------------------------------------------------------------------------
+# Files and the reference configuration
+# --------------------------------------------------------------------------
+
+
+def test_reference_toml_loads_and_equals_the_dict(tmp_path):
+    path = tmp_path / "paper.toml"
+    path.write_text(REFERENCE_TOML)
+    from_file = load_config(path)
+    # Same fields (the built plugin objects are distinct instances).
+    assert from_file.model_dump() == load_config(REFERENCE).model_dump()
+    assert from_file.steps == 10000 and from_file.realizations == 200
+    assert from_file.friction.static.params == {"mean": 0.6, "std": 0.01}
+    assert load_config(str(path)).model_dump() == from_file.model_dump()  # a str path works too
+
+
+def test_reference_toml_runs_with_fewer_steps(tmp_path):
+    # The TOML of MODEL.md section 5, with steps 10000 -> 100 and
+    # realizations 200 -> 3 by editing the parsed dict (to keep the test fast).
+    path = tmp_path / "paper.toml"
+    path.write_text(REFERENCE_TOML)
+    with path.open("rb") as fh:
+        cfg = tomllib.load(fh)
+    cfg["steps"], cfg["realizations"] = 100, 3
+    ds = slidernet.run(cfg)
+    assert ds.sizes == {"realization": 3, "t": ds.sizes["t"]}
+    assert int(ds["t"][-1]) == 100
+    assert {"n", "mu_max", "x_G", "mu_eff"} <= set(ds.data_vars)
+    assert ds.attrs["seed"] == "1"
+
+
+def test_model_md_example_dict_runs_as_written():
+    # MODEL.md section 5 as a dict, unchanged except steps 10000 -> 200 and
+    # realizations 200 -> 4 (the full run takes minutes).
+    cfg = make_config(steps=200, realizations=4)
+    assert {k: v for k, v in cfg.items() if k not in ("steps", "realizations")} == {
+        k: v for k, v in REFERENCE.items() if k not in ("steps", "realizations")
+    }
+    ds = slidernet.run(cfg)
+    assert ds["n"].shape == (4, ds.sizes["t"])
+    # Close to eq. `slope`: about 53.6 rearrangements per tau_th (loose: 10 %).
+    assert 48 < float(ds["r_mean"]) < 59
+    assert np.isfinite(ds["mu_eff"].values).all()
+
+
+def test_missing_file(tmp_path):
+    missing = tmp_path / "nope.toml"
+    with pytest.raises(ConfigError, match=r"The configuration file '.*nope\.toml' does not exist"):
+        load_config(missing)
+
+
+def test_invalid_toml(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text("steps = \n[network\n")
+    with pytest.raises(ConfigError, match=r"The configuration file '.*bad\.toml' is not valid TOML"):
+        load_config(path)
+
+
+def test_toml_with_a_bad_value_names_the_field(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(REFERENCE_TOML.replace("mu_d = 0.5", "mu_d = -0.5"))
+    with pytest.raises(ConfigError, match=r"'friction\.mu_d' field must be > 0"):
+        load_config(path)
