@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +32,11 @@ def realization_seeds(seed: int, realizations: int) -> list[np.random.SeedSequen
     return np.random.SeedSequence(seed).spawn(realizations)
 
 
-def run(config: Config | Mapping[str, Any] | str | Path, progress: bool | None = False) -> xr.Dataset:
+def run(
+    config: Config | Mapping[str, Any] | str | Path,
+    progress: bool | None = False,
+    on_realization: Callable[[int], None] | None = None,
+) -> xr.Dataset:
     """Simulate an ensemble of realizations and return the result dataset.
 
     Parameters
@@ -41,6 +45,9 @@ def run(config: Config | Mapping[str, Any] | str | Path, progress: bool | None =
         The run configuration (MODEL.md section 5); a path is read as TOML.
     progress : bool or None
         Show a progress bar over realizations (None: only on a terminal).
+    on_realization : callable, optional
+        Called with the index of each realization once it is done (for
+        callers that drive their own progress display).
 
     Returns
     -------
@@ -65,10 +72,12 @@ def run(config: Config | Mapping[str, Any] | str | Path, progress: bool | None =
     cfg = resolve_seed(load_config(config))
     scene = Scene.from_config(cfg)
     seeds = realization_seeds(cfg.seed, cfg.realizations)
-    records = [
-        simulate(scene, ss)
-        for ss in tqdm(seeds, desc="realizations", disable=None if progress is None else not progress)
-    ]
+    records = []
+    bar = tqdm(seeds, desc="realizations", disable=None if progress is None else not progress)
+    for r, ss in enumerate(bar):
+        records.append(simulate(scene, ss))
+        if on_realization is not None:
+            on_realization(r)
     attrs = {
         "config": json.dumps(cfg.model_dump(mode="json"), sort_keys=True),
         "slidernet_version": slidernet.__version__,

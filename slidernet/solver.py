@@ -13,6 +13,7 @@ one rearrangement to the next by solving eq. `critique` exactly.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -133,10 +134,17 @@ def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
     return thetas
 
 
-def _refill(buf: np.ndarray, pos: int, fresh: np.ndarray) -> np.ndarray:
-    # Keep the unread tail: the stream of draws is then the same whatever
-    # point the kernel stopped at.
-    return np.concatenate([buf[pos:], fresh])
+def _refill(buf: np.ndarray, pos: int, draw: Callable[[int], np.ndarray], batch: int) -> np.ndarray:
+    """``buf`` from ``pos`` on, topped up with a new batch when fewer than ``batch`` remain.
+
+    Keeping the unread tail makes the stream of draws the same whatever
+    point the kernel stopped at. A buffer that still holds a batch is left
+    alone: refilling it anyway would make it grow without bound (the tilt
+    test's uniforms are read only in its rare creep branch).
+    """
+    if buf.size - pos >= batch:
+        return buf[pos:]
+    return np.concatenate([buf[pos:], draw(batch)])
 
 
 class Realization:
@@ -250,18 +258,23 @@ class Realization:
         thetas = self.thetas[: to_step + 1]
         dist = sc.distribution
         ist = self.ist
+
+        def draw_mu(size: int) -> np.ndarray:
+            return dist.sample(self.rngs["thresholds"], size)
+
+        def draw_tmu(size: int) -> np.ndarray:
+            return dist.sample(self.rngs["tilt"], size)
+
         while True:
             status = self._call_kernel(thetas)
             if status == kernels.DONE:
                 return self
             if status == kernels.NEED_MU:
-                self.mu_buf = _refill(self.mu_buf, ist[kernels.MU_POS],
-                                      dist.sample(self.rngs["thresholds"], sc.batch))
+                self.mu_buf = _refill(self.mu_buf, ist[kernels.MU_POS], draw_mu, sc.batch)
                 ist[kernels.MU_POS] = 0
             elif status == kernels.NEED_TILT:
-                self.tmu = _refill(self.tmu, ist[kernels.TMU_POS],
-                                   dist.sample(self.rngs["tilt"], sc.batch))
-                self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt"].random(sc.batch))
+                self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], draw_tmu, sc.batch)
+                self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt"].random, sc.batch)
                 ist[kernels.TMU_POS] = 0
                 ist[kernels.TU_POS] = 0
             elif status == kernels.AVALANCHE_LIMIT:
