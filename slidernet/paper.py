@@ -116,10 +116,10 @@ def _config(sigma_theta: float, steps: int, realizations: int, seed: int, *, mu_
 
 # Cost model for the progress bar only, in units of one plain rearrangement
 # (~30 M/s on the reference machine): a thermal step costs about 25 of them,
-# and a rearrangement with the tilt test about 20 at mu_d = 0.5 and 5 at
-# mu_d = 0.4 (measured over 1e5 steps; the test gets slower as mu_max grows).
+# and a rearrangement with the tilt test about 4 at mu_d = 0.5 and 1 at
+# mu_d = 0.4 (benchmarks/bench_two_slider.py: ~10 M/s with the test).
 _STEP_COST = 25.0
-_TILT_COST = 20.0
+_TILT_COST = 4.0
 
 
 def _cost_per_realization(cfg: dict[str, Any]) -> int:
