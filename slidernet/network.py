@@ -39,15 +39,15 @@ def _per_item(value, size: int, name: str, owner: str) -> np.ndarray:
 
 
 class Network:
-    """A 1D network of sliders joined by linear springs.
+    """A 1D or 2D network of sliders joined by linear springs.
 
     Constructors validate and store; the sparse operators are built by
     :meth:`stiffness_matrix` and :meth:`thermal_load`.
 
     Parameters
     ----------
-    positions : array_like, shape (N,)
-        Reference positions X_i of the sliders along x, in l0.
+    positions : array_like, shape (N,) or (N, 2)
+        Reference positions X_i of the sliders, in l0 (along x in 1D).
     edges : array_like of int, shape (E, 2)
         Springs as pairs (i, j) of node indices.
     Ntilde : float
@@ -56,6 +56,10 @@ class Network:
         Spring stiffnesses in units of k0 = N / (Ntilde l0) (default 1).
     kappa : float or array_like, shape (E,)
         Thermal expansion of each spring relative to the slider material (default 1).
+    rest_length : float or array_like, shape (E,), optional
+        Natural length of each spring at theta = 0, in l0, which sets its
+        thermal load k L kappa theta (default: the distance |X_j - X_i|).
+        The initial state is at rest whatever it is.
     normal_load : float or array_like, shape (N,)
         Normal loads N_i in units of N (default 1); they also weight x_G.
 
@@ -78,24 +82,30 @@ class Network:
         k: float | Sequence[float] = 1.0,
         kappa: float | Sequence[float] = 1.0,
         normal_load: float | Sequence[float] = 1.0,
+        rest_length: float | Sequence[float] | None = None,
     ) -> None:
         owner = "Network"
         Ntilde = float(Ntilde)
         if not (math.isfinite(Ntilde) and Ntilde > 0):
             raise param_error("Ntilde", owner, "finite and > 0", Ntilde)
-        x = np.asarray(positions, dtype=float).reshape(-1)
-        if x.size < 2:
-            raise param_error("positions", owner, "at least 2 nodes", x.size)
+        x = np.asarray(positions, dtype=float)
+        if x.ndim == 1:
+            x = x[:, None]
+        if x.ndim != 2 or x.shape[1] not in (1, 2):
+            raise param_error("positions", owner, "of shape (N,) or (N, 2)", x.shape)
+        if x.shape[0] < 2:
+            raise param_error("positions", owner, "at least 2 nodes", x.shape[0])
         if not np.isfinite(x).all():
-            raise param_error("positions", owner, "finite", positions)
+            raise param_error("positions", owner, "finite", "non-finite values")
         e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if e.shape[0] == 0:
             raise param_error("edges", owner, "at least one spring", 0)
-        if e.min() < 0 or e.max() >= x.size:
-            raise param_error("edges", owner, f"node indices in [0, {x.size - 1}]", e.tolist())
+        if e.min() < 0 or e.max() >= x.shape[0]:
+            raise param_error("edges", owner, f"node indices in [0, {x.shape[0] - 1}]",
+                              f"indices from {e.min()} to {e.max()}")
         if (e[:, 0] == e[:, 1]).any():
-            raise param_error("edges", owner, "free of self-loops", e.tolist())
-        length = np.abs(x[e[:, 1]] - x[e[:, 0]])
+            raise param_error("edges", owner, "free of self-loops", "a self-loop")
+        length = np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1)
         if (length == 0).any():
             raise ConfigError(
                 "Two sliders joined by a spring share one position; springs need length > 0."
@@ -107,35 +117,53 @@ class Network:
         if (self.k <= 0).any():
             raise param_error("k", owner, "> 0 for every spring", k)
         self.kappa = _per_item(kappa, e.shape[0], "kappa", owner)
-        self.normal_load = _per_item(normal_load, x.size, "normal_load", owner)
+        self.normal_load = _per_item(normal_load, x.shape[0], "normal_load", owner)
         if (self.normal_load <= 0).any():
             raise param_error("normal_load", owner, "> 0 for every slider", normal_load)
+        if rest_length is None:
+            self.rest_length = length
+        else:
+            self.rest_length = _per_item(rest_length, e.shape[0], "rest_length", owner)
+            if (self.rest_length <= 0).any():
+                raise param_error("rest_length", owner, "> 0 for every spring", rest_length)
 
     @property
     def n_nodes(self) -> int:
         """Number of sliders N."""
-        return self.positions.size
+        return self.positions.shape[0]
+
+    @property
+    def dim(self) -> int:
+        """Dimension d of the displacements (1 or 2)."""
+        return self.positions.shape[1]
 
     @property
     def n_edges(self) -> int:
         """Number of springs E."""
         return self.edges.shape[0]
 
-    def rest_length(self) -> np.ndarray:
-        """Spring lengths |X_j - X_i| at theta = 0, in l0, shape (E,)."""
-        return np.abs(self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]])
+    def unit_vectors(self) -> np.ndarray:
+        """Unit vectors e_e from node i to node j of every spring, shape (E, d)."""
+        d = self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]]
+        return d / np.linalg.norm(d, axis=1)[:, None]
 
     def incidence(self) -> sp.csr_matrix:
-        """Oriented incidence matrix B times the unit vectors, shape (E, N)."""
+        """Oriented incidence matrix B times the unit vectors, shape (E, N d).
+
+        Row e gives the extension of spring e: (B u)_e = e_e . (u_j - u_i),
+        with u flattened node-major (u[i d + c] is component c of node i).
+        """
+        d = self.dim
         i, j = self.edges[:, 0], self.edges[:, 1]
-        unit = np.sign(self.positions[j] - self.positions[i])
-        rows = np.repeat(np.arange(self.n_edges), 2)
-        cols = np.column_stack([i, j]).reshape(-1)
-        vals = np.column_stack([-unit, unit]).reshape(-1)
-        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_edges, self.n_nodes))
+        unit = self.unit_vectors()
+        comp = np.arange(d)
+        rows = np.repeat(np.arange(self.n_edges), 2 * d)
+        cols = np.concatenate([i[:, None] * d + comp, j[:, None] * d + comp], axis=1).reshape(-1)
+        vals = np.concatenate([-unit, unit], axis=1).reshape(-1)
+        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n_edges, self.n_nodes * d))
 
     def stiffness_matrix(self) -> sp.csr_matrix:
-        """K = B^T diag(k) B in units of k0, shape (N, N), CSR with sorted indices."""
+        """K = B^T diag(k) B in units of k0, shape (N d, N d), CSR with sorted indices."""
         b = self.incidence()
         K = (b.T @ sp.diags(self.k) @ b).tocsr()
         K.sum_duplicates()
@@ -143,51 +171,75 @@ class Network:
         return K
 
     def thermal_load(self) -> np.ndarray:
-        """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N,)."""
-        return self.incidence().T @ (self.k * self.rest_length() * self.kappa)
+        """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N d,), node-major."""
+        return self.incidence().T @ (self.k * self.rest_length * self.kappa)
 
     def is_two_slider(self) -> bool:
         """True for the paper's scene: 2 sliders, one spring, all values at their defaults."""
         return (
             self.n_nodes == 2
+            and self.dim == 1
             and self.n_edges == 1
-            and self.positions[1] - self.positions[0] == 1.0
+            and self.positions[1, 0] - self.positions[0, 0] == 1.0
+            and self.rest_length[0] == 1.0
             and tuple(self.edges[0]) == (0, 1)
             and bool((self.k == 1.0).all() and (self.kappa == 1.0).all())
             and bool((self.normal_load == 1.0).all())
         )
 
     def to_networkx(self) -> nx.Graph:
-        """The network as a networkx graph (``x``, ``normal_load``, ``k``, ``kappa`` attributes)."""
+        """The network as a networkx graph.
+
+        Node attributes: ``pos`` (a tuple of d floats, in l0) and
+        ``normal_load``; edge attributes: ``k``, ``kappa``, ``rest_length``.
+        """
         G = nx.Graph()
-        for i, (xi, ni) in enumerate(zip(self.positions, self.normal_load, strict=True)):
-            G.add_node(i, x=float(xi), normal_load=float(ni))
-        for (i, j), ke, kap in zip(self.edges, self.k, self.kappa, strict=True):
-            G.add_edge(int(i), int(j), k=float(ke), kappa=float(kap))
+        for i in range(self.n_nodes):
+            G.add_node(i, pos=tuple(float(c) for c in self.positions[i]),
+                       normal_load=float(self.normal_load[i]))
+        for e, (i, j) in enumerate(self.edges):
+            G.add_edge(int(i), int(j), k=float(self.k[e]), kappa=float(self.kappa[e]),
+                       rest_length=float(self.rest_length[e]))
         return G
 
     @classmethod
-    def from_networkx(cls, G: nx.Graph, Ntilde: float) -> Network:
-        """Build from a networkx graph whose nodes carry an ``x`` position (in l0).
+    def from_networkx(cls, G: nx.Graph, Ntilde: float, **overrides) -> Network:
+        """Build from a networkx graph whose nodes carry positions (in l0).
 
-        Optional attributes: ``normal_load`` on nodes, ``k`` and ``kappa`` on edges.
-        Nodes are numbered in ``G.nodes`` order.
+        A node's position is its ``pos`` attribute (a sequence of 1 or 2
+        floats) or its ``x`` (and ``y``) attributes. Optional attributes:
+        ``normal_load`` on nodes; ``k``, ``kappa`` and ``rest_length`` on
+        edges. Nodes are numbered in ``G.nodes`` order. Keyword ``overrides``
+        (``k``, ``kappa``, ``normal_load``, ``rest_length``) replace the
+        attributes for every node or edge.
         """
         nodes = list(G.nodes)
+        if len(nodes) < 2:
+            raise ConfigError(f"A network needs at least 2 sliders; the graph has {len(nodes)}.")
         index = {v: n for n, v in enumerate(nodes)}
-        try:
-            x = [float(G.nodes[v]["x"]) for v in nodes]
-        except KeyError as exc:
-            raise ConfigError("Every node of the graph needs an 'x' position attribute.") from exc
+        positions = []
+        for v in nodes:
+            data = G.nodes[v]
+            if "pos" in data:
+                positions.append([float(c) for c in np.atleast_1d(data["pos"])])
+            elif "x" in data:
+                positions.append([float(data["x"])] + ([float(data["y"])] if "y" in data else []))
+            else:
+                raise ConfigError(f"Node {v!r} of the graph has no position ('pos', or 'x' and 'y').")
         edges = [(index[a], index[b]) for a, b in G.edges]
-        return cls(
-            positions=x,
-            edges=edges,
-            Ntilde=Ntilde,
-            k=[float(d.get("k", 1.0)) for _, _, d in G.edges(data=True)],
-            kappa=[float(d.get("kappa", 1.0)) for _, _, d in G.edges(data=True)],
-            normal_load=[float(G.nodes[v].get("normal_load", 1.0)) for v in nodes],
-        )
+        edata = [d for _, _, d in G.edges(data=True)]
+        attrs = {
+            "k": [float(d.get("k", 1.0)) for d in edata],
+            "kappa": [float(d.get("kappa", 1.0)) for d in edata],
+            "normal_load": [float(G.nodes[v].get("normal_load", 1.0)) for v in nodes],
+        }
+        if any("rest_length" in d for d in edata):
+            geometric = np.linalg.norm(np.subtract([positions[b] for _, b in edges],
+                                                   [positions[a] for a, _ in edges]), axis=1)
+            attrs["rest_length"] = [float(d.get("rest_length", geometric[e]))
+                                    for e, d in enumerate(edata)]
+        attrs.update(overrides)
+        return cls(positions=positions, edges=edges, Ntilde=Ntilde, **attrs)
 
     def __repr__(self) -> str:
         return f"Network(N={self.n_nodes}, E={self.n_edges}, Ntilde={self.Ntilde!r})"
