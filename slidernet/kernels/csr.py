@@ -1,0 +1,194 @@
+"""General 1D networks: CSR rows of K, a heap of unstable nodes, two driving heaps.
+
+The force on node i is F_i = a_i + g_i theta, with a = -K u - g theta(0)
+(+ f_ext) updated incrementally on the CSR row of the slipped node. A node
+is stable while |F_i| <= mu_s,i N_i, i.e. while theta lies between its two
+critical values theta_dn,i <= theta <= theta_up,i (eq. `critique` for node i);
+these only change when the node or a neighbour slips.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from slidernet.kernels.heap import avalanche_done, heap_set
+from slidernet.kernels.state import (
+    ARGMAX,
+    AV_SLIPS,
+    AVALANCHE_LIMIT,
+    DONE,
+    DOWN_SIZE,
+    ERR_NODE,
+    HEAP_SIZE,
+    IN_AVALANCHE,
+    MU_MAX,
+    MU_POS,
+    N_EVENTS,
+    N_RECORDS,
+    N_SLIPS,
+    NEED_MU,
+    REC,
+    RECOMPUTE,
+    SINCE_RECOMPUTE,
+    STARTED,
+    THETA,
+    UP_SIZE,
+    XG,
+    Q,
+    write_record,
+)
+from slidernet.kernels.tilt import tilt_sample
+
+
+@njit(cache=True)
+def update_node(j, theta, a, g, mu, normal_load, hp, hpos, hkey, ist):
+    """Re-key node j in the three heaps after its force or threshold changed."""
+    F = a[j] + g[j] * theta
+    lim = mu[j] * normal_load[j]
+    heap_set(j, abs(F) / lim, abs(F) > lim, hp, hpos, hkey, 0, ist, HEAP_SIZE)
+    gj = g[j]
+    if gj != 0.0:
+        # The two roots of |a_j + g_j theta| = mu_s,j N_j.
+        if gj > 0.0:
+            up = (lim - a[j]) / gj
+            dn = (-lim - a[j]) / gj
+        else:
+            up = (-lim - a[j]) / gj
+            dn = (lim - a[j]) / gj
+        heap_set(j, -up, True, hp, hpos, hkey, 1, ist, UP_SIZE)
+        heap_set(j, dn, True, hp, hpos, hkey, 2, ist, DOWN_SIZE)
+
+
+@njit(cache=True)
+def init_csr_heaps(a, g, mu, normal_load, hp, hpos, hkey, ist, fst):
+    """(Re)build the three heaps from scratch, O(N log N)."""
+    hpos[:] = -1
+    ist[HEAP_SIZE] = 0
+    ist[UP_SIZE] = 0
+    ist[DOWN_SIZE] = 0
+    theta = fst[THETA]
+    for j in range(mu.size):
+        update_node(j, theta, a, g, mu, normal_load, hp, hpos, hkey, ist)
+
+
+@njit(cache=True)
+def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
+          ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips):
+    """Node i slips alone (undamped half-oscillation); its threshold is redrawn."""
+    sgn = 1.0 if Fi > 0.0 else -1.0
+    du = 2.0 * (absF - mu_d * normal_load[i]) * sgn / kdiag[i]
+    u[i] += du
+    for p in range(indptr[i], indptr[i + 1]):
+        a[indices[p]] -= kdata[p] * du
+    fst[XG] += du * w[i]
+    new = mu_buf[ist[MU_POS]]
+    ist[MU_POS] += 1
+    old = mu[i]
+    mu[i] = new
+    if new > fst[MU_MAX]:
+        ist[N_RECORDS] += 1
+        fst[MU_MAX] = new
+        ist[ARGMAX] = i
+    elif i == ist[ARGMAX] and new < old:
+        # The strongest node slipped (possible in networks): rescan.
+        best = 0
+        for j in range(mu.size):
+            if mu[j] > mu[best]:
+                best = j
+        ist[ARGMAX] = best
+        fst[MU_MAX] = mu[best]
+    ist[N_SLIPS] += 1
+    ist[SINCE_RECOMPUTE] += 1
+    node_slips[i] += 1
+    theta = fst[THETA]
+    for p in range(indptr[i], indptr[i + 1]):
+        update_node(indices[p], theta, a, g, mu, normal_load, hp, hpos, hkey, ist)
+
+
+@njit(cache=True)
+def run_csr(
+    thetas, rec_times, mu, ist, fst, a, u, mu_buf, tmu, tu, mu_d, do_tilt, max_slips,
+    recompute_every, indptr, indices, kdata, kdiag, g, normal_load, w, hp, hpos, hkey,
+    aval_hist, node_slips, out_n, out_mu_max, out_xg, out_records, fsum, fsq, fcount,
+):
+    """Advance a 1D network through ``thetas`` (units of Ntilde).
+
+    The heaps must have been built by :func:`init_csr_heaps`. The tilt test
+    (``do_tilt``) is defined for 2-node networks only. Returns ``RECOMPUTE``
+    every ``recompute_every`` slips (0: never) so that the caller can
+    recompute ``a`` from ``u`` and rebuild the heaps.
+    """
+    steps = thetas.size - 1
+    if ist[STARTED] == 0:
+        if do_tilt:
+            F = a[1] + g[1] * fst[THETA]
+            st = tilt_sample(F, mu[0], mu[1], mu_d, tmu, tu, ist, ist[REC], fsum, fsq, fcount)
+            if st != DONE:
+                return st
+        if rec_times[ist[REC]] == 0:
+            write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+        ist[STARTED] = 1
+    while True:
+        while ist[HEAP_SIZE] > 0:
+            i = hp[0, 0]
+            theta = fst[THETA]
+            Fi = a[i] + g[i] * theta
+            ist[AV_SLIPS] += 1
+            if ist[AV_SLIPS] > max_slips:
+                ist[ERR_NODE] = i
+                return AVALANCHE_LIMIT
+            # The buffer check comes first: a kernel that returns after the
+            # tilt sample would take it again on re-entry.
+            if ist[MU_POS] >= mu_buf.size:
+                ist[AV_SLIPS] -= 1
+                return NEED_MU
+            if do_tilt:
+                st = tilt_sample(a[1] + g[1] * theta, mu[0], mu[1], mu_d, tmu, tu, ist,
+                                 ist[REC], fsum, fsq, fcount)
+                if st != DONE:
+                    ist[AV_SLIPS] -= 1
+                    return st
+            _slip(i, Fi, abs(Fi), a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
+                  ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips)
+        avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
+        if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
+            return RECOMPUTE
+        q = ist[Q]
+        if q >= steps:
+            return DONE
+        theta_b = thetas[q + 1]
+        s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
+        best = -1
+        if s > 0.0 and ist[UP_SIZE] > 0:
+            best = hp[1, 0]
+            thc = -hkey[1, best]
+        elif s < 0.0 and ist[DOWN_SIZE] > 0:
+            best = hp[2, 0]
+            thc = hkey[2, best]
+        if best >= 0:
+            theta = fst[THETA]
+            if s * (thc - theta) < 0.0:
+                thc = theta  # rounding: the node is already at its threshold
+            if s * (theta_b - thc) >= 0.0:
+                fst[THETA] = thc
+                if ist[MU_POS] >= mu_buf.size:
+                    return NEED_MU
+                if do_tilt:
+                    st = tilt_sample(a[1] + g[1] * thc, mu[0], mu[1], mu_d, tmu, tu, ist,
+                                     ist[REC], fsum, fsq, fcount)
+                    if st != DONE:
+                        return st
+                # At theta_c the force on the node is exactly +-mu_s N, with the
+                # sign of g s (the direction its force moves).
+                lim = mu[best] * normal_load[best]
+                sigma = 1.0 if g[best] * s > 0.0 else -1.0
+                ist[AV_SLIPS] = 0
+                ist[IN_AVALANCHE] = 1
+                ist[N_EVENTS] += 1
+                _slip(best, sigma * lim, lim, a, u, mu, indptr, indices, kdata, kdiag, g,
+                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips)
+                continue
+        ist[Q] = q + 1
+        fst[THETA] = theta_b
+        if ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1:
+            write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)

@@ -1,0 +1,69 @@
+"""Layout of the kernels' state arrays and return codes.
+
+A kernel's whole state lives in two arrays, ``ist`` (int64) and ``fst``
+(float64), plus the per-node arrays, so that a kernel can stop at any clean
+point and resume later (buffer refills, checkpoints).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Return codes.
+DONE = 0
+NEED_MU = 1  # the horizontal threshold buffer is empty
+NEED_TILT = 2  # the tilt-test buffers ran out during a test (rolled back)
+AVALANCHE_LIMIT = 3  # an avalanche exceeded max_slips
+TILT_LIMIT = 4  # a tilt test exceeded its iteration cap
+RECOMPUTE = 5  # time to recompute the forces from the displacements (drift control)
+
+# Integer state (ist) slots.
+Q = 0  # next thermal step: the segment thetas[q] -> thetas[q+1]
+N_SLIPS = 1  # cumulative rearrangements n
+REC = 2  # index of the next record time
+MU_POS = 3  # read position in the threshold buffer
+TMU_POS = 4  # read position in the tilt-test threshold buffer
+TU_POS = 5  # read position in the tilt-test uniform buffer
+N_RECORDS = 6  # draws that exceeded the running mu_max
+ARGMAX = 7  # node holding mu_max
+ERR_NODE = 8  # node named by an error
+AV_SLIPS = 9  # slips in the current avalanche
+HEAP_SIZE = 10  # size of the unstable-node heap (pair: 1 while a slider is unstable)
+N_EVENTS = 11  # driving events (= avalanches)
+STARTED = 12  # 1 once the t = 0 record is written
+UP_SIZE = 13  # size of the heap of upper critical thetas (driving with theta increasing)
+DOWN_SIZE = 14  # size of the heap of lower critical thetas (theta decreasing)
+SINCE_RECOMPUTE = 15  # slips since the forces were last recomputed from u
+IN_AVALANCHE = 16  # 1 between a driving slip and the end of its avalanche
+N_IST = 17
+
+N_AVALANCHE_BINS = 64  # avalanche sizes s are binned by floor(log2 s)
+
+# Float state (fst) slots.
+THETA = 0  # current theta / Ntilde
+XG = 1  # centre-of-mass displacement / (Ntilde l0)
+MU_MAX = 2  # largest threshold mu_s
+U = 3  # run_pair only: the paper's u / Ntilde (spring length change)
+YG = 4  # run_vec only: centre-of-mass displacement along y / (Ntilde l0)
+N_FST = 5
+
+TILT_MAX_ITER = 1_000_000
+
+
+
+
+def empty_state() -> tuple[np.ndarray, np.ndarray]:
+    """Fresh (ist, fst) arrays."""
+    return np.zeros(N_IST, dtype=np.int64), np.zeros(N_FST, dtype=np.float64)
+
+
+@njit(cache=True)
+def write_record(ist, fst, out_n, out_mu_max, out_xg, out_records):
+    """Write the counters into record slot ``ist[REC]`` and advance it."""
+    k = ist[REC]
+    out_n[k] = ist[N_SLIPS]
+    out_mu_max[k] = fst[MU_MAX]
+    out_xg[k] = fst[XG]
+    out_records[k] = ist[N_RECORDS]
+    ist[REC] = k + 1

@@ -1,0 +1,333 @@
+"""General 2D networks: vector forces, 2x2 blocks of K, three heaps.
+
+The force on node i is the 2-vector F_i = a_i + g_i theta (a = -K u - g
+theta(0) + f_ext), and node i sticks while |F_i| <= mu_s,i N_i. Along a
+linear segment of theta, |F_i(theta)|^2 = (mu_s,i N_i)^2 is a quadratic in
+theta (MODEL.md section 2) whose roots theta_dn,i <= theta <= theta_up,i
+bound the node's stable range: they key the driving heaps.
+
+A slip moves node i alone, the others fixed, as an undamped half-oscillation
+under Coulomb friction with the local stiffness K_ii (a 2x2 block):
+
+* ``slip_mode = 0`` (straight line): along F_i with the stiffness
+  k = F^T K_ii F / |F|^2 of that line, Delta u_i = 2 (|F_i| - mu_d N_i) F_i / (|F_i| k).
+  Exact when K_ii is isotropic (interior nodes of square and triangular
+  lattices); an approximation otherwise.
+* ``slip_mode = 1`` (exact): the 2D motion u'' = F_i - K_ii (u - u0) - mu_d N_i v/|v|
+  is integrated (RK4, 4000 steps per period of the stiffest mode) from rest
+  until the velocity reverses, i.e. the node comes to rest.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from slidernet.kernels.heap import avalanche_done, heap_set
+from slidernet.kernels.state import (
+    ARGMAX,
+    AV_SLIPS,
+    AVALANCHE_LIMIT,
+    DONE,
+    DOWN_SIZE,
+    ERR_NODE,
+    HEAP_SIZE,
+    IN_AVALANCHE,
+    MU_MAX,
+    MU_POS,
+    N_EVENTS,
+    N_RECORDS,
+    N_SLIPS,
+    NEED_MU,
+    REC,
+    RECOMPUTE,
+    SINCE_RECOMPUTE,
+    STARTED,
+    THETA,
+    UP_SIZE,
+    XG,
+    YG,
+    Q,
+)
+
+SLIP_STRAIGHT = 0
+SLIP_EXACT = 1
+_STEPS_PER_PERIOD = 4000
+_MAX_PERIODS = 50
+
+
+@njit(cache=True)
+def critical_thetas(ax, ay, gx, gy, lim):
+    """Roots (theta_dn, theta_up) of |a + g theta| = lim, in the numerically stable form."""
+    A = gx * gx + gy * gy
+    B = ax * gx + ay * gy
+    C = ax * ax + ay * ay - lim * lim
+    disc = B * B - A * C
+    if disc < 0.0:
+        disc = 0.0  # rounding at a tangency
+    sq = math.sqrt(disc)
+    if B >= 0.0:
+        q = -B - sq
+        if q == 0.0:
+            return 0.0, 0.0
+        r1 = q / A
+        r2 = C / q
+    else:
+        q = -B + sq
+        r1 = C / q
+        r2 = q / A
+    # At a tangency the two roots meet and rounding may swap them.
+    return min(r1, r2), max(r1, r2)
+
+
+@njit(cache=True)
+def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
+    """Displacement of a node sliding from rest under F - K x and friction fd (2D, unit mass).
+
+    Returns (dx, dy, steps); steps < 0 if the motion did not stop within
+    ``_MAX_PERIODS`` periods of the softest mode (or 5e7 steps).
+    """
+    root = math.sqrt(0.25 * (kxx - kyy) ** 2 + kxy * kxy)
+    lam = 0.5 * (kxx + kyy) + root
+    lam_soft = max(0.5 * (kxx + kyy) - root, 1e-12 * lam)
+    h = 2.0 * math.pi / math.sqrt(lam) / _STEPS_PER_PERIOD
+    # A soft direction slows the motion down: budget periods of the softest mode.
+    budget = int(_STEPS_PER_PERIOD * _MAX_PERIODS * max(1.0, math.sqrt(lam / lam_soft)))
+    budget = min(budget, 50_000_000)
+    absF = math.hypot(Fx, Fy)
+    # Friction opposes the velocity; it keeps the direction of motion of the
+    # start of the step (the force direction at rest) whenever a stage
+    # velocity points backwards, so that at the stop the velocity reverses
+    # cleanly instead of chattering about zero.
+    px = Fx / absF
+    py = Fy / absF
+    x = 0.0
+    y = 0.0
+    vx = 0.0
+    vy = 0.0
+    for n in range(budget):
+        k1x, k1y = vx, vy
+        a1x, a1y = _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd, px, py)
+        k2x, k2y = vx + 0.5 * h * a1x, vy + 0.5 * h * a1y
+        a2x, a2y = _acc(x + 0.5 * h * k1x, y + 0.5 * h * k1y, k2x, k2y, Fx, Fy, kxx, kxy, kyy, fd, px, py)
+        k3x, k3y = vx + 0.5 * h * a2x, vy + 0.5 * h * a2y
+        a3x, a3y = _acc(x + 0.5 * h * k2x, y + 0.5 * h * k2y, k3x, k3y, Fx, Fy, kxx, kxy, kyy, fd, px, py)
+        k4x, k4y = vx + h * a3x, vy + h * a3y
+        a4x, a4y = _acc(x + h * k3x, y + h * k3y, k4x, k4y, Fx, Fy, kxx, kxy, kyy, fd, px, py)
+        nx_ = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x)
+        ny_ = y + h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y)
+        nvx = vx + h / 6.0 * (a1x + 2.0 * a2x + 2.0 * a3x + a4x)
+        nvy = vy + h / 6.0 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y)
+        if n > 0 and nvx * px + nvy * py <= 0.0:
+            # The velocity reverses within this step: the node stops where its
+            # component along the direction of motion vanishes (linear in time
+            # near the stop); the position follows the step's cubic Hermite.
+            p0 = vx * px + vy * py
+            p1 = nvx * px + nvy * py
+            tau = p0 / (p0 - p1) if p0 != p1 else 1.0
+            h00 = 2 * tau**3 - 3 * tau**2 + 1
+            h10 = tau**3 - 2 * tau**2 + tau
+            h01 = -2 * tau**3 + 3 * tau**2
+            h11 = tau**3 - tau**2
+            return (h00 * x + h10 * h * vx + h01 * nx_ + h11 * h * nvx,
+                    h00 * y + h10 * h * vy + h01 * ny_ + h11 * h * nvy, n + 1)
+        x, y, vx, vy = nx_, ny_, nvx, nvy
+        v = math.hypot(vx, vy)
+        if v > 0.0:
+            px = vx / v
+            py = vy / v
+    return x, y, -1
+
+
+@njit(cache=True, inline="always")
+def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd, px, py):
+    ex = px
+    ey = py
+    if vx * px + vy * py > 0.0:
+        v = math.hypot(vx, vy)
+        ex = vx / v
+        ey = vy / v
+    return Fx - (kxx * x + kxy * y) - fd * ex, Fy - (kxy * x + kyy * y) - fd * ey
+
+
+@njit(cache=True)
+def update_node(j, theta, a, g, driven, mu, normal_load, hp, hpos, hkey, ist):
+    """Re-key node j in the three heaps after its force or threshold changed."""
+    Fx = a[j, 0] + g[j, 0] * theta
+    Fy = a[j, 1] + g[j, 1] * theta
+    F = math.hypot(Fx, Fy)
+    lim = mu[j] * normal_load[j]
+    heap_set(j, F / lim, F > lim, hp, hpos, hkey, 0, ist, HEAP_SIZE)
+    if driven[j]:
+        dn, up = critical_thetas(a[j, 0], a[j, 1], g[j, 0], g[j, 1], lim)
+        heap_set(j, -up, True, hp, hpos, hkey, 1, ist, UP_SIZE)
+        heap_set(j, dn, True, hp, hpos, hkey, 2, ist, DOWN_SIZE)
+
+
+@njit(cache=True)
+def init_vec_heaps(a, g, driven, mu, normal_load, hp, hpos, hkey, ist, fst):
+    """(Re)build the three heaps from scratch, O(N log N)."""
+    hpos[:] = -1
+    ist[HEAP_SIZE] = 0
+    ist[UP_SIZE] = 0
+    ist[DOWN_SIZE] = 0
+    for j in range(mu.size):
+        update_node(j, fst[THETA], a, g, driven, mu, normal_load, hp, hpos, hkey, ist)
+
+
+@njit(cache=True)
+def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load, w,
+          ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey, node_slips):
+    """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
+    fd = mu_d * normal_load[i]
+    d = diagpos[i]  # the diagonal block K_ii
+    kxx = kblk[d, 0, 0]
+    kxy = kblk[d, 0, 1]
+    kyy = kblk[d, 1, 1]
+    if slip_mode == SLIP_EXACT:
+        dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
+        if nsteps < 0:
+            return False
+    else:
+        ex = Fx / absF
+        ey = Fy / absF
+        keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
+        length = 2.0 * (absF - fd) / keff
+        dux = length * ex
+        duy = length * ey
+    u[i, 0] += dux
+    u[i, 1] += duy
+    for p in range(indptr[i], indptr[i + 1]):
+        j = indices[p]
+        # K is symmetric, so K_ji du_i = K_ij du_i with the stored row i.
+        a[j, 0] -= kblk[p, 0, 0] * dux + kblk[p, 0, 1] * duy
+        a[j, 1] -= kblk[p, 1, 0] * dux + kblk[p, 1, 1] * duy
+    fst[XG] += dux * w[i]
+    fst[YG] += duy * w[i]
+    new = mu_buf[ist[MU_POS]]
+    ist[MU_POS] += 1
+    old = mu[i]
+    mu[i] = new
+    if new > fst[MU_MAX]:
+        ist[N_RECORDS] += 1
+        fst[MU_MAX] = new
+        ist[ARGMAX] = i
+    elif i == ist[ARGMAX] and new < old:
+        best = 0
+        for j in range(mu.size):
+            if mu[j] > mu[best]:
+                best = j
+        ist[ARGMAX] = best
+        fst[MU_MAX] = mu[best]
+    ist[N_SLIPS] += 1
+    ist[SINCE_RECOMPUTE] += 1
+    node_slips[i] += 1
+    theta = fst[THETA]
+    for p in range(indptr[i], indptr[i + 1]):
+        update_node(indices[p], theta, a, g, driven, mu, normal_load, hp, hpos, hkey, ist)
+    return True
+
+
+@njit(cache=True)
+def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min):
+    k = ist[REC]
+    out_n[k] = ist[N_SLIPS]
+    out_mu_max[k] = fst[MU_MAX]
+    out_xg[k] = fst[XG]
+    out_yg[k] = fst[YG]
+    out_records[k] = ist[N_RECORDS]
+    # O(N) at record times only (log-spaced by default).
+    out_mu_mean[k] = np.mean(mu)
+    out_mu_min[k] = np.min(mu)
+    ist[REC] = k + 1
+
+
+@njit(cache=True)
+def run_vec(
+    thetas, rec_times, mu, ist, fst, a, u, mu_buf, mu_d, max_slips, recompute_every, slip_mode,
+    indptr, indices, kblk, diagpos, g, driven, normal_load, w, hp, hpos, hkey, aval_hist,
+    node_slips, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
+):
+    """Advance a 2D network through ``thetas`` (units of Ntilde).
+
+    ``a``, ``u``, ``g`` have shape (N, 2); ``kblk`` (nnzb, 2, 2) holds the
+    blocks K_ij of the block-CSR rows (``indptr``, ``indices``), and
+    ``diagpos[i]`` the position of K_ii. The
+    heaps must have been built by :func:`init_vec_heaps`; an unstable initial
+    state (a large f_ext) is relaxed first.
+    """
+    steps = thetas.size - 1
+    if ist[STARTED] == 0:
+        if ist[HEAP_SIZE] == 0 and rec_times[ist[REC]] == 0:
+            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean,
+                    out_mu_min)
+            ist[STARTED] = 1
+        elif ist[HEAP_SIZE] > 0:
+            ist[IN_AVALANCHE] = 1
+    while True:
+        while ist[HEAP_SIZE] > 0:
+            i = hp[0, 0]
+            theta = fst[THETA]
+            Fx = a[i, 0] + g[i, 0] * theta
+            Fy = a[i, 1] + g[i, 1] * theta
+            ist[AV_SLIPS] += 1
+            if ist[AV_SLIPS] > max_slips:
+                ist[ERR_NODE] = i
+                return AVALANCHE_LIMIT
+            if ist[MU_POS] >= mu_buf.size:
+                ist[AV_SLIPS] -= 1
+                return NEED_MU
+            if not _slip(i, Fx, Fy, math.hypot(Fx, Fy), a, u, mu, indptr, indices, kblk, diagpos, g, driven,
+                         normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey,
+                         node_slips):
+                ist[ERR_NODE] = i
+                return AVALANCHE_LIMIT
+        avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
+        if ist[STARTED] == 0:
+            # The initial relaxation (f_ext above a threshold) belongs to t = 0.
+            if rec_times[ist[REC]] == 0:
+                _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records,
+                        out_mu_mean, out_mu_min)
+            ist[STARTED] = 1
+        if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
+            return RECOMPUTE
+        q = ist[Q]
+        if q >= steps:
+            return DONE
+        theta_b = thetas[q + 1]
+        s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
+        best = -1
+        if s > 0.0 and ist[UP_SIZE] > 0:
+            best = hp[1, 0]
+            thc = -hkey[1, best]
+        elif s < 0.0 and ist[DOWN_SIZE] > 0:
+            best = hp[2, 0]
+            thc = hkey[2, best]
+        if best >= 0:
+            theta = fst[THETA]
+            if s * (thc - theta) < 0.0:
+                thc = theta
+            if s * (theta_b - thc) >= 0.0:
+                fst[THETA] = thc
+                if ist[MU_POS] >= mu_buf.size:
+                    return NEED_MU
+                # At theta_c, |F| = mu_s N exactly; its direction is computed.
+                lim = mu[best] * normal_load[best]
+                Fx = a[best, 0] + g[best, 0] * thc
+                Fy = a[best, 1] + g[best, 1] * thc
+                ist[AV_SLIPS] = 0
+                ist[IN_AVALANCHE] = 1
+                ist[N_EVENTS] += 1
+                if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g, driven,
+                             normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey,
+                             node_slips):
+                    ist[ERR_NODE] = best
+                    return AVALANCHE_LIMIT
+                continue
+        ist[Q] = q + 1
+        fst[THETA] = theta_b
+        if ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1:
+            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean,
+                    out_mu_min)
