@@ -32,7 +32,11 @@ from slidernet.errors import ConfigError, param_error
 
 
 def _per_item(value, size: int, name: str, owner: str) -> np.ndarray:
-    arr = np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy()
+    try:
+        arr = np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy()
+    except ValueError:
+        raise param_error(name, owner, f"a number or an array of {size} values",
+                          f"an array of shape {np.shape(value)}") from None
     if not np.isfinite(arr).all():
         raise param_error(name, owner, "finite", value)
     return arr
@@ -110,6 +114,13 @@ class Network:
             raise ConfigError(
                 "Two sliders joined by a spring share one position; springs need length > 0."
             )
+        degree = np.bincount(e.reshape(-1), minlength=x.shape[0])
+        if (degree == 0).any():
+            # K_ii = 0: such a slider could never stop sliding.
+            raise ConfigError(
+                f"Slider {int(np.flatnonzero(degree == 0)[0])} has no spring; every slider "
+                "needs at least one."
+            )
         self.positions = x
         self.edges = e
         self.Ntilde = Ntilde
@@ -169,6 +180,35 @@ class Network:
         K.sum_duplicates()
         K.sort_indices()
         return K
+
+    def stiffness_blocks(self) -> sp.bsr_matrix:
+        """K as a block-sparse matrix of d x d blocks, assembled directly from the springs.
+
+        The same matrix as :meth:`stiffness_matrix`, built without the sparse
+        product: block K_ij = -k_e e_e e_e^T for every spring and K_ii the sum
+        of the node's spring blocks. Entries are ordered by row with scipy's
+        COO-to-CSR conversion; rows carry their diagonal block.
+
+        >>> K = chain(3, Ntilde=1e-7).stiffness_blocks()
+        >>> bool((K.toarray() == chain(3, Ntilde=1e-7).stiffness_matrix().toarray()).all())
+        True
+        """
+        N, d = self.n_nodes, self.dim
+        i, j = self.edges[:, 0], self.edges[:, 1]
+        e = self.unit_vectors()
+        b = self.k[:, None, None] * e[:, :, None] * e[:, None, :]
+        diag = np.empty((N, d, d))
+        for c1 in range(d):
+            for c2 in range(d):
+                diag[:, c1, c2] = (np.bincount(i, b[:, c1, c2], minlength=N)
+                                   + np.bincount(j, b[:, c1, c2], minlength=N))
+        rows = np.concatenate([i, j, np.arange(N)])
+        cols = np.concatenate([j, i, np.arange(N)])
+        order = sp.coo_matrix((np.arange(1, rows.size + 1), (rows, cols)), shape=(N, N)).tocsr()
+        if order.nnz != rows.size:  # parallel springs: let the sparse product sum them
+            return self.stiffness_matrix().tobsr(blocksize=(d, d))
+        data = np.concatenate([-b, -b, diag])[order.data - 1]
+        return sp.bsr_matrix((data, order.indices, order.indptr), shape=(N * d, N * d))
 
     def thermal_load(self) -> np.ndarray:
         """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N d,), node-major."""
