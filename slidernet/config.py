@@ -61,20 +61,61 @@ class PluginSpec(BaseModel):
         return dict(self.model_extra or {})
 
 
-class NetworkConfig(_Strict):
-    """The network: the paper's ``two_slider`` or a ``chain`` of ``n`` sliders."""
+_KIND_PARAMS = {
+    "two_slider": set(),
+    "chain": {"n"},
+    "square": {"shape"},
+    "triangular": {"shape"},
+    "irregular": {"n", "seed"},
+    "graph": {"path"},
+}
 
-    kind: Literal["two_slider", "chain"] = "two_slider"
+
+class NetworkConfig(_Strict):
+    """The network: its ``kind``, its size, and uniform overrides of the defaults.
+
+    ``two_slider`` (the paper), ``chain`` (``n``), ``square`` and
+    ``triangular`` (``shape = [rows, cols]``), ``irregular`` (``n`` random
+    points joined by their Delaunay triangulation, drawn from ``seed``: the
+    geometry is quenched, the same for every realization) and ``graph``
+    (``path`` of a GraphML or edge-list file). ``k`` (in units of
+    N / (Ntilde l0)), ``kappa`` and ``normal_load`` (in units of N) replace
+    the default 1 on every spring or node.
+    """
+
+    kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = "two_slider"
     Ntilde: PositiveFloat
     n: Annotated[int, Field(ge=2)] | None = None
+    shape: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = None
+    path: str | None = None
+    seed: Annotated[int, Field(ge=0)] | None = None
+    k: PositiveFloat | None = None
+    kappa: Annotated[float, Field(allow_inf_nan=False)] | None = None
+    normal_load: PositiveFloat | None = None
 
     @model_validator(mode="after")
-    def _n_matches_kind(self) -> NetworkConfig:
-        if self.kind == "chain" and self.n is None:
-            raise ValueError("a chain needs 'n', its number of sliders")
-        if self.kind == "two_slider" and self.n not in (None, 2):
-            raise ValueError(f"two_slider has n = 2 sliders; got n = {self.n}")
+    def _params_match_kind(self) -> NetworkConfig:
+        wanted = _KIND_PARAMS[self.kind]
+        given = {p for p in ("n", "shape", "path", "seed") if getattr(self, p) is not None}
+        if self.kind == "two_slider" and self.n == 2:
+            given.discard("n")
+        extra = given - wanted
+        if extra:
+            raise ValueError(f"a {self.kind} network does not take {sorted(extra)}")
+        missing = (wanted - {"seed"}) - given
+        if missing:
+            raise ValueError(f"a {self.kind} network needs {sorted(missing)}")
+        if self.shape is not None and self.shape[0] * self.shape[1] < 2:
+            raise ValueError(f"shape {list(self.shape)} has fewer than 2 sliders")
         return self
+
+    def size(self) -> int | None:
+        """Number of sliders, when known without reading a file."""
+        if self.kind == "two_slider":
+            return 2
+        if self.shape is not None:
+            return self.shape[0] * self.shape[1]
+        return self.n
 
 
 class FrictionConfig(_Strict):
@@ -88,12 +129,18 @@ class SolverConfig(_Strict):
     """Choices of the quasi-static solver.
 
     ``kernel = "auto"`` picks the scalar ``pair`` kernel for the paper's
-    two-slider scene and the general ``csr`` kernel otherwise.
+    two-slider scene, ``csr`` for other 1D networks and ``vec`` in 2D.
+    ``recompute_every`` (slips; 0: never) resets the incrementally updated
+    forces from the displacements by a sparse mat-vec, against drift.
+    ``slip`` chooses, in 2D, between the straight-line slip along the force
+    (exact where K_ii is isotropic) and the exactly integrated 2D slip.
     """
 
-    kernel: Literal["auto", "pair", "csr"] = "auto"
+    kernel: Literal["auto", "pair", "csr", "vec"] = "auto"
     max_avalanche: Annotated[int, Field(ge=1)] = 100_000_000
     batch: Annotated[int, Field(ge=16)] = 1 << 16
+    recompute_every: Annotated[int, Field(ge=0)] = 10_000_000
+    slip: Literal["straight", "exact"] = "straight"
 
 
 class Config(_Strict):
@@ -120,19 +167,15 @@ class Config(_Strict):
         if isinstance(self.record, list):
             if any(t > self.steps for t in self.record):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
-        if "mu_eff" in self.observables and self.n_nodes != 2:
+        size = self.network.size()
+        if "mu_eff" in self.observables and size not in (2, None):
             raise ValueError(
                 "the 'mu_eff' observable (the appendix's tilt test) is defined for 2 sliders; "
-                f"this network has {self.n_nodes}"
+                f"this network has {size}"
             )
-        if self.solver.kernel == "pair" and self.network.kind == "chain" and self.n_nodes != 2:
+        if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
         return self
-
-    @property
-    def n_nodes(self) -> int:
-        """Number of sliders in the configured network."""
-        return 2 if self.network.kind == "two_slider" else int(self.network.n)
 
     def distribution(self) -> TruncatedBelow:
         """The mu_s distribution, truncated below mu_d (built once, cached)."""
@@ -239,6 +282,12 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
         except tomllib.TOMLDecodeError as exc:
             raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+        # A graph file named in a config file is found next to that file.
+        network = source.get("network")
+        if isinstance(network, dict) and isinstance(network.get("path"), str):
+            graph = Path(network["path"])
+            if not graph.is_absolute():
+                network["path"] = str(path.parent / graph)
     if isinstance(source, Config):
         cfg = source
     else:

@@ -37,6 +37,31 @@ def _sem(x: np.ndarray) -> np.ndarray:
     return x.std(axis=0, ddof=1) / np.sqrt(R)
 
 
+def _network_variables(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> None:
+    """Variables that only network kernels record (MODEL.md: networks add their own)."""
+    first = records[0]
+    per_t = {
+        "y_G": ("centre-of-mass displacement along y since t = 0", "l0"),
+        "mu_mean": ("mean static threshold over the nodes", "1"),
+        "mu_min": ("weakest static threshold in the network", "1"),
+    }
+    for name, (long_name, units) in per_t.items():
+        if name in first:
+            ds[name] = (("realization", "t"), np.stack([r[name] for r in records]),
+                        {"long_name": long_name, "units": units})
+    if "avalanche_count" in first:
+        counts = np.stack([r["avalanche_count"] for r in records])
+        ds["avalanche_count"] = (("realization", "avalanche_size"), counts, {
+            "long_name": "number of avalanches (driving slip + triggered slips) per size bin "
+                         "[s, 2 s), s = avalanche_size", "units": "1"})
+        ds.coords["avalanche_size"] = 2 ** np.arange(counts.shape[1], dtype=np.int64)
+    if "node_slips" in first:
+        ds["node_slips"] = (("realization", "node"), np.stack([r["node_slips"] for r in records]),
+                            {"long_name": "number of slips of each node", "units": "1"})
+        ds["mu_s"] = (("realization", "node"), np.stack([r["mu_s"] for r in records]),
+                      {"long_name": "static threshold of each node at the end", "units": "1"})
+
+
 def assemble(
     records: list[dict[str, np.ndarray]],
     t: np.ndarray,
@@ -81,6 +106,7 @@ def assemble(
                                {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
             ds["x_G2_sem"] = ("t", _sem(x2),
                               {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+    _network_variables(ds, records)
     if "n" in observables and ds.sizes["t"] > 1:
         steps = int(t[-1])
         r = np.array([rec["n"][-1] / steps for rec in records])

@@ -21,8 +21,8 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.config import Config
-from slidernet.errors import AvalancheError, TiltTestError
-from slidernet.network import Network, chain, two_slider
+from slidernet.errors import AvalancheError, ConfigError, TiltTestError
+from slidernet.network import Network
 from slidernet.registry import checked_output
 
 
@@ -46,10 +46,56 @@ def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> n
 
 
 def build_network(cfg: Config) -> Network:
-    """The network of the configured scene."""
-    if cfg.network.kind == "two_slider":
-        return two_slider(cfg.network.Ntilde)
-    return chain(cfg.network.n, Ntilde=cfg.network.Ntilde)
+    """The network of the configured scene (its own seed: the geometry is quenched)."""
+    from slidernet.builders import build
+
+    net_cfg = cfg.network
+    params = net_cfg.model_dump(exclude={"kind", "Ntilde", "seed"}, exclude_none=True)
+    # seed None means 0, not fresh entropy: a network is part of the scene.
+    rng = np.random.Generator(np.random.PCG64(net_cfg.seed or 0))
+    return build(net_cfg.kind, params, net_cfg.Ntilde, rng)
+
+
+def _operators(net: Network) -> tuple[str, Any, dict[str, np.ndarray]]:
+    """The kernel family of a network, its stiffness matrix K and the arrays the kernel runs on.
+
+    1D: the CSR rows of K. 2D: the block-CSR rows of its 2x2 blocks, which
+    share memory with the returned ``scipy.sparse.bsr_matrix``. Entries of g
+    below 1e-12 of its largest entry are set to exactly zero: in a uniform
+    lattice the interior loads cancel up to rounding, and a node with g_i = 0
+    is never driven directly (it stays out of the driving heaps).
+    """
+    g = net.thermal_load()
+    gmax = np.abs(g).max() if g.size else 0.0
+    g = np.where(np.abs(g) > 1e-12 * gmax, g, 0.0)
+    common = {
+        "normal_load": net.normal_load.astype(np.float64),
+        "w": net.normal_load / net.normal_load.sum(),
+    }
+    if net.dim == 1:
+        K = net.stiffness_matrix()
+        return "csr", K, {
+            **common,
+            "indptr": K.indptr.astype(np.int64),
+            "indices": K.indices.astype(np.int64),
+            "kdata": K.data.astype(np.float64),
+            "kdiag": K.diagonal().astype(np.float64),
+            "g": g.astype(np.float64),
+        }
+    K = net.stiffness_blocks()
+    indptr = K.indptr.astype(np.int64)
+    indices = K.indices.astype(np.int64)
+    row = np.repeat(np.arange(net.n_nodes), np.diff(indptr))
+    g2 = g.reshape(-1, 2).astype(np.float64)
+    return "vec", K, {
+        **common,
+        "indptr": indptr,
+        "indices": indices,
+        "kblk": K.data,
+        "diagpos": np.flatnonzero(indices == row).astype(np.int64),
+        "g": g2,
+        "driven": (g2 != 0).any(axis=1),
+    }
 
 
 @dataclass
@@ -58,8 +104,13 @@ class Scene:
 
     Attributes
     ----------
-    kernel : {"pair", "csr"}
-        The specialized kernel picked for this scene.
+    kernel : {"pair", "csr", "vec"}
+        The specialized kernel picked for this scene: ``pair`` for the
+        paper's two sliders, ``csr`` for other 1D networks, ``vec`` in 2D.
+    ops : dict of str to ndarray
+        The arrays the network kernels run on (see ``_operators``).
+    K : scipy.sparse matrix or None
+        The stiffness matrix, for the periodic recomputation of the forces.
     """
 
     network: Network
@@ -74,27 +125,28 @@ class Scene:
     do_tilt: bool
     max_avalanche: int
     batch: int
-    csr: dict[str, np.ndarray] = field(default_factory=dict)
+    recompute_every: int
+    slip_mode: int
+    ops: dict[str, np.ndarray] = field(default_factory=dict)
+    K: Any = None
 
     @classmethod
-    def from_config(cls, cfg: Config) -> Scene:
+    def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
-        net = build_network(cfg)
+        net = build_network(cfg) if network is None else network
+        family, K, ops = _operators(net)
         kernel = cfg.solver.kernel
         if kernel == "auto":
-            kernel = "pair" if net.is_two_slider() else "csr"
-        K = net.stiffness_matrix()
-        g = net.thermal_load()
-        csr = {
-            "indptr": K.indptr.astype(np.int64),
-            "indices": K.indices.astype(np.int64),
-            "kdata": K.data.astype(np.float64),
-            "kdiag": K.diagonal().astype(np.float64),
-            "g": g.astype(np.float64),
-            "normal_load": net.normal_load.copy(),
-            "w": net.normal_load / net.normal_load.sum(),
-            "driven": np.flatnonzero(g != 0).astype(np.int64),
-        }
+            kernel = "pair" if net.is_two_slider() else family
+        if kernel != family and not (kernel == "pair" and net.is_two_slider()):
+            raise ConfigError(
+                f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
+            )
+        if "mu_eff" in cfg.observables and net.n_nodes != 2:
+            raise ConfigError(
+                "The 'observables' field: 'mu_eff' (the appendix's tilt test) is defined for 2 "
+                f"sliders; this network has {net.n_nodes}."
+            )
         return cls(
             network=net,
             distribution=cfg.distribution(),
@@ -108,7 +160,10 @@ class Scene:
             do_tilt="mu_eff" in cfg.observables,
             max_avalanche=cfg.solver.max_avalanche,
             batch=cfg.solver.batch,
-            csr=csr,
+            recompute_every=cfg.solver.recompute_every,
+            slip_mode=1 if cfg.solver.slip == "exact" else 0,
+            ops=ops,
+            K=K,
         )
 
 
@@ -191,13 +246,48 @@ class Realization:
         self.fst[kernels.U] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
         self.fst[kernels.MU_MAX] = self.mu.max()
         self.ist[kernels.ARGMAX] = int(np.argmax(self.mu))
-        if scene.kernel == "csr":
-            # a = F - theta g with u = 0: every spring at rest at theta(0).
-            self.a = -scene.csr["g"] * self.thetas[0]
-            self.u = np.zeros(net.n_nodes)
-            self.heap = np.zeros(net.n_nodes, np.int64)
-            self.pos = np.full(net.n_nodes, -1, np.int64)
-            self.key = np.zeros(net.n_nodes)
+        if scene.kernel != "pair":
+            self._init_network_state()
+
+    def _init_network_state(self) -> None:
+        N = self.scene.network.n_nodes
+        g = self.scene.ops["g"]
+        # a = F - theta g with u = 0: every spring at rest at theta(0).
+        self.a = -g * self.thetas[0]
+        self.u = np.zeros_like(g)
+        self.hp = np.zeros((3, N), np.int64)
+        self.hpos = np.full((3, N), -1, np.int64)
+        self.hkey = np.zeros((3, N))
+        self.aval_hist = np.zeros(kernels.N_AVALANCHE_BINS, np.int64)
+        self.node_slips = np.zeros(N, np.int64)
+        if self.scene.kernel == "vec":
+            T = self.scene.rec_times.size
+            self.out.update(y_G=np.zeros(T), mu_mean=np.zeros(T), mu_min=np.zeros(T))
+        self._rebuild_heaps()
+
+    def _rebuild_heaps(self) -> None:
+        o = self.scene.ops
+        if self.scene.kernel == "vec":
+            kernels.init_vec_heaps(self.a, o["g"], o["driven"], self.mu, o["normal_load"], self.hp,
+                                   self.hpos, self.hkey, self.ist, self.fst)
+        else:
+            kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hpos,
+                                   self.hkey, self.ist, self.fst)
+
+    def recompute_forces(self) -> float:
+        """Recompute a = -K u - g theta(0) from the displacements (sparse mat-vec).
+
+        Incremental updates of ``a`` accumulate rounding; this resets it and
+        rebuilds the heaps. Returns the largest change of a force, in N (the
+        drift that had accumulated).
+        """
+        g = self.scene.ops["g"]
+        fresh = (-(self.scene.K @ self.u.reshape(-1)) - g.reshape(-1) * self.thetas[0]).reshape(g.shape)
+        drift = float(np.abs(fresh - self.a).max())
+        self.a[...] = fresh
+        self.ist[kernels.SINCE_RECOMPUTE] = 0
+        self._rebuild_heaps()
+        return drift
 
     @property
     def step(self) -> int:
@@ -225,27 +315,46 @@ class Realization:
         return float(self.fst[kernels.XG] * self.scene.network.Ntilde)
 
     def forces(self) -> np.ndarray:
-        """Spring forces on every node, in units of N, shape (N,)."""
+        """Spring forces on every node, in units of N, shape (N,) in 1D or (N, 2) in 2D."""
         theta = self.fst[kernels.THETA]
         if self.scene.kernel == "pair":
             F = theta - self.fst[kernels.U]
             return np.array([-F, F])
-        return self.a + self.scene.csr["g"] * theta
+        return self.a + self.scene.ops["g"] * theta
+
+    def displacements(self) -> np.ndarray:
+        """Displacements u of the nodes from their reference positions, in l0, shape (N, d)."""
+        Ntilde = self.scene.network.Ntilde
+        if self.scene.kernel == "pair":
+            # Slider 1 and 2 about the centre of mass; u = theta(0) at rest.
+            half = 0.5 * (self.fst[kernels.U] - self.thetas[0])
+            xg = self.fst[kernels.XG]
+            return Ntilde * np.array([[xg - half], [xg + half]])
+        return Ntilde * self.u.reshape(self.scene.network.n_nodes, -1)
 
     def _call_kernel(self, thetas: np.ndarray) -> int:
-        sc, c, out = self.scene, self.scene.csr, self.out
+        sc, o, out = self.scene, self.scene.ops, self.out
         if sc.kernel == "pair":
             return kernels.run_pair(
                 thetas, sc.rec_times, self.mu, self.ist, self.fst, self.mu_buf, self.tmu,
                 self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, out["n"], out["mu_max"],
                 out["x_G"], out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
             )
-        return kernels.run_csr(
+        if sc.kernel == "csr":
+            return kernels.run_csr(
+                thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
+                self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, sc.recompute_every,
+                o["indptr"], o["indices"], o["kdata"], o["kdiag"], o["g"], o["normal_load"],
+                o["w"], self.hp, self.hpos, self.hkey, self.aval_hist, self.node_slips,
+                out["n"], out["mu_max"], out["x_G"], out["n_records"], out["f_sum"],
+                out["f_sq"], out["f_count"],
+            )
+        return kernels.run_vec(
             thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
-            self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, c["indptr"],
-            c["indices"], c["kdata"], c["kdiag"], c["g"], c["normal_load"], c["w"],
-            c["driven"], self.heap, self.pos, self.key, out["n"], out["mu_max"], out["x_G"],
-            out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
+            sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
+            o["indices"], o["kblk"], o["diagpos"], o["g"], o["driven"], o["normal_load"], o["w"], self.hp,
+            self.hpos, self.hkey, self.aval_hist, self.node_slips, out["n"], out["mu_max"],
+            out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
         )
 
     def advance(self, to_step: int | None = None) -> Realization:
@@ -277,12 +386,15 @@ class Realization:
                 self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt"].random, sc.batch)
                 ist[kernels.TMU_POS] = 0
                 ist[kernels.TU_POS] = 0
+            elif status == kernels.RECOMPUTE:
+                self.recompute_forces()
             elif status == kernels.AVALANCHE_LIMIT:
                 i = int(ist[kernels.ERR_NODE])
+                force = np.round(np.atleast_1d(self.forces()[i]), 12).tolist()
                 raise AvalancheError(
                     f"An avalanche did not end after {sc.max_avalanche} slips "
-                    f"(solver.max_avalanche) during step {ist[kernels.Q]}: node {i} is still "
-                    f"unstable with F = {float(self.forces()[i])!r} N, "
+                    f"(solver.max_avalanche), or a slip did not come to rest, during step "
+                    f"{ist[kernels.Q]}: node {i} is unstable with F = {force} N, "
                     f"mu_s = {float(self.mu[i])!r}, theta = {self.theta!r}."
                 )
             elif status == kernels.TILT_LIMIT:
@@ -304,8 +416,15 @@ class Realization:
             record bin, shape (T,), and the scalar ``n_events``.
         """
         res = {k: v.copy() for k, v in self.out.items()}
-        res["x_G"] *= self.scene.network.Ntilde
+        Ntilde = self.scene.network.Ntilde
+        res["x_G"] *= Ntilde
+        if "y_G" in res:
+            res["y_G"] *= Ntilde
         res["n_events"] = np.int64(self.ist[kernels.N_EVENTS])
+        if self.scene.kernel != "pair":
+            res["avalanche_count"] = self.aval_hist.copy()
+            res["node_slips"] = self.node_slips.copy()
+            res["mu_s"] = self.mu.copy()
         return res
 
 

@@ -341,8 +341,8 @@ def test_avalanche_limit_is_reported(kernel):
     # mu_min > 3 mu_d common (mu_d = 0.1) a longer avalanche comes soon (seed 1).
     cfg = make_config(steps=200, realizations=1, observables=["n"],
                       **{**AGREEMENT_CASES["avalanches"], "solver.max_avalanche": 1, "solver.kernel": kernel})
-    with pytest.raises(AvalancheError, match=r"did not end after 1 slips \(solver\.max_avalanche\) during step "
-                                             r"\d+: node [01] is still unstable"):
+    with pytest.raises(AvalancheError, match=r"did not end after 1 slips \(solver\.max_avalanche\).* during step "
+                                             r"\d+: node [01] is unstable"):
         slidernet.run(cfg)
 
 
