@@ -11,9 +11,8 @@ from __future__ import annotations
 
 from numba import njit
 
-from slidernet.kernels.heap import avalanche_done, heap_set
+from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
 from slidernet.kernels.state import (
-    ARGMAX,
     AV_SLIPS,
     AVALANCHE_LIMIT,
     DONE,
@@ -21,11 +20,8 @@ from slidernet.kernels.state import (
     ERR_NODE,
     HEAP_SIZE,
     IN_AVALANCHE,
-    MU_MAX,
     MU_POS,
     N_EVENTS,
-    N_RECORDS,
-    N_SLIPS,
     NEED_MU,
     REC,
     RECOMPUTE,
@@ -81,25 +77,7 @@ def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, 
     for p in range(indptr[i], indptr[i + 1]):
         a[indices[p]] -= kdata[p] * du
     fst[XG] += du * w[i]
-    new = mu_buf[ist[MU_POS]]
-    ist[MU_POS] += 1
-    old = mu[i]
-    mu[i] = new
-    if new > fst[MU_MAX]:
-        ist[N_RECORDS] += 1
-        fst[MU_MAX] = new
-        ist[ARGMAX] = i
-    elif i == ist[ARGMAX] and new < old:
-        # The strongest node slipped (possible in networks): rescan.
-        best = 0
-        for j in range(mu.size):
-            if mu[j] > mu[best]:
-                best = j
-        ist[ARGMAX] = best
-        fst[MU_MAX] = mu[best]
-    ist[N_SLIPS] += 1
-    ist[SINCE_RECOMPUTE] += 1
-    node_slips[i] += 1
+    redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
     theta = fst[THETA]
     for p in range(indptr[i], indptr[i + 1]):
         update_node(indices[p], theta, a, g, mu, normal_load, hp, hpos, hkey, ist)

@@ -1,4 +1,4 @@
-"""Indexed binary max-heaps for the event engine.
+"""Indexed binary max-heaps for the event engine, and the bookkeeping of a slip.
 
 A heap holds node indices ordered by a per-node ``key`` (largest first, ties
 to the lowest node index, which is the documented tie rule of MODEL.md).
@@ -15,6 +15,15 @@ min-heap on theta_up is a max-heap on -theta_up with the same tie rule.
 from __future__ import annotations
 
 from numba import njit
+
+from slidernet.kernels.state import (
+    ARGMAX,
+    MU_MAX,
+    MU_POS,
+    N_RECORDS,
+    N_SLIPS,
+    SINCE_RECOMPUTE,
+)
 
 
 @njit(cache=True, inline="always")
@@ -105,3 +114,30 @@ def avalanche_done(ist, aval_hist, av_slot, flag_slot):
             b += 1
         aval_hist[b] += 1
         ist[flag_slot] = 0
+
+
+@njit(cache=True)
+def redraw_threshold(i, mu, mu_buf, ist, fst, node_slips):
+    """After node i slipped: draw its new mu_s, keep mu_max and its holder, count the slip.
+
+    mu_max is kept incrementally; only when the strongest node itself slips
+    (possible in networks, never with two sliders) is it found by a rescan.
+    """
+    new = mu_buf[ist[MU_POS]]
+    ist[MU_POS] += 1
+    old = mu[i]
+    mu[i] = new
+    if new > fst[MU_MAX]:
+        ist[N_RECORDS] += 1
+        fst[MU_MAX] = new
+        ist[ARGMAX] = i
+    elif i == ist[ARGMAX] and new < old:
+        best = 0
+        for j in range(mu.size):
+            if mu[j] > mu[best]:
+                best = j
+        ist[ARGMAX] = best
+        fst[MU_MAX] = mu[best]
+    ist[N_SLIPS] += 1
+    ist[SINCE_RECOMPUTE] += 1
+    node_slips[i] += 1

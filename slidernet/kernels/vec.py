@@ -25,9 +25,8 @@ import math
 import numpy as np
 from numba import njit
 
-from slidernet.kernels.heap import avalanche_done, heap_set
+from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
 from slidernet.kernels.state import (
-    ARGMAX,
     AV_SLIPS,
     AVALANCHE_LIMIT,
     DONE,
@@ -206,24 +205,7 @@ def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, 
         a[j, 1] -= kblk[p, 1, 0] * dux + kblk[p, 1, 1] * duy
     fst[XG] += dux * w[i]
     fst[YG] += duy * w[i]
-    new = mu_buf[ist[MU_POS]]
-    ist[MU_POS] += 1
-    old = mu[i]
-    mu[i] = new
-    if new > fst[MU_MAX]:
-        ist[N_RECORDS] += 1
-        fst[MU_MAX] = new
-        ist[ARGMAX] = i
-    elif i == ist[ARGMAX] and new < old:
-        best = 0
-        for j in range(mu.size):
-            if mu[j] > mu[best]:
-                best = j
-        ist[ARGMAX] = best
-        fst[MU_MAX] = mu[best]
-    ist[N_SLIPS] += 1
-    ist[SINCE_RECOMPUTE] += 1
-    node_slips[i] += 1
+    redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
     theta = fst[THETA]
     for p in range(indptr[i], indptr[i + 1]):
         update_node(indices[p], theta, a, g, driven, mu, normal_load, hp, hpos, hkey, ist)
