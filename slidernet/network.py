@@ -109,7 +109,8 @@ class Network:
                               f"indices from {e.min()} to {e.max()}")
         if (e[:, 0] == e[:, 1]).any():
             raise param_error("edges", owner, "free of self-loops", "a self-loop")
-        length = np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1)
+        dx = x[e[:, 1]] - x[e[:, 0]]
+        length = np.abs(dx[:, 0]) if x.shape[1] == 1 else np.hypot(dx[:, 0], dx[:, 1])
         if (length == 0).any():
             raise ConfigError(
                 "Two sliders joined by a spring share one position; springs need length > 0."
@@ -156,7 +157,12 @@ class Network:
     def unit_vectors(self) -> np.ndarray:
         """Unit vectors e_e from node i to node j of every spring, shape (E, d)."""
         d = self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]]
-        return d / np.linalg.norm(d, axis=1)[:, None]
+        return d / self.lengths()[:, None]
+
+    def lengths(self) -> np.ndarray:
+        """Distances |X_j - X_i| of every spring's ends, in l0, shape (E,)."""
+        d = self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]]
+        return np.abs(d[:, 0]) if self.dim == 1 else np.hypot(d[:, 0], d[:, 1])
 
     def incidence(self) -> sp.csr_matrix:
         """Oriented incidence matrix B times the unit vectors, shape (E, N d).
@@ -186,33 +192,39 @@ class Network:
 
         The same matrix as :meth:`stiffness_matrix`, built without the sparse
         product: block K_ij = -k_e e_e e_e^T for every spring and K_ii the sum
-        of the node's spring blocks. Entries are ordered by row with scipy's
-        COO-to-CSR conversion; rows carry their diagonal block.
+        of the node's spring blocks, written row by row in one compiled pass
+        (:mod:`slidernet.kernels.assembly`); every row carries its diagonal
+        block and its columns are sorted.
 
         >>> K = chain(3, Ntilde=1e-7).stiffness_blocks()
         >>> bool((K.toarray() == chain(3, Ntilde=1e-7).stiffness_matrix().toarray()).all())
         True
         """
+        from slidernet.kernels.assembly import assemble_blocks
+
         N, d = self.n_nodes, self.dim
-        i, j = self.edges[:, 0], self.edges[:, 1]
         e = self.unit_vectors()
         b = self.k[:, None, None] * e[:, :, None] * e[:, None, :]
-        diag = np.empty((N, d, d))
-        for c1 in range(d):
-            for c2 in range(d):
-                diag[:, c1, c2] = (np.bincount(i, b[:, c1, c2], minlength=N)
-                                   + np.bincount(j, b[:, c1, c2], minlength=N))
-        rows = np.concatenate([i, j, np.arange(N)])
-        cols = np.concatenate([j, i, np.arange(N)])
-        order = sp.coo_matrix((np.arange(1, rows.size + 1), (rows, cols)), shape=(N, N)).tocsr()
-        if order.nnz != rows.size:  # parallel springs: let the sparse product sum them
+        indptr, indices, data, duplicate = assemble_blocks(N, self.edges[:, 0], self.edges[:, 1], b)
+        if duplicate:  # parallel springs: let the sparse product sum them
             return self.stiffness_matrix().tobsr(blocksize=(d, d))
-        data = np.concatenate([-b, -b, diag])[order.data - 1]
-        return sp.bsr_matrix((data, order.indices, order.indptr), shape=(N * d, N * d))
+        return sp.bsr_matrix((data, indices, indptr), shape=(N * d, N * d), copy=False)
 
     def thermal_load(self) -> np.ndarray:
-        """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N d,), node-major."""
-        return self.incidence().T @ (self.k * self.rest_length * self.kappa)
+        """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N d,), node-major.
+
+        Spring e pushes its ends apart along e_e with k L kappa per unit
+        theta/Ntilde: node j gets + k L kappa e_e, node i gets - k L kappa e_e.
+        Summed with bincount, not through the incidence matrix: the same
+        numbers, a fraction of the memory at a million nodes.
+        """
+        N, d = self.n_nodes, self.dim
+        f = (self.k * self.rest_length * self.kappa)[:, None] * self.unit_vectors()
+        g = np.empty((N, d))
+        for c in range(d):
+            g[:, c] = (np.bincount(self.edges[:, 1], f[:, c], minlength=N)
+                       - np.bincount(self.edges[:, 0], f[:, c], minlength=N))
+        return g.reshape(-1)
 
     def is_two_slider(self) -> bool:
         """True for the paper's scene: 2 sliders, one spring, all values at their defaults."""

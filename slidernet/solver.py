@@ -256,8 +256,8 @@ class Realization:
         self.a = -g * self.thetas[0]
         self.u = np.zeros_like(g)
         self.hp = np.zeros((3, N), np.int64)
-        self.hpos = np.full((3, N), -1, np.int64)
-        self.hkey = np.zeros((3, N))
+        self.hpos = np.full((N, 3), -1, np.int64)
+        self.hv = np.zeros((3, N))
         self.aval_hist = np.zeros(kernels.N_AVALANCHE_BINS, np.int64)
         self.node_slips = np.zeros(N, np.int64)
         if self.scene.kernel == "vec":
@@ -269,10 +269,10 @@ class Realization:
         o = self.scene.ops
         if self.scene.kernel == "vec":
             kernels.init_vec_heaps(self.a, o["g"], o["driven"], self.mu, o["normal_load"], self.hp,
-                                   self.hpos, self.hkey, self.ist, self.fst)
+                                   self.hv, self.hpos, self.ist, self.fst)
         else:
-            kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hpos,
-                                   self.hkey, self.ist, self.fst)
+            kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hv,
+                                   self.hpos, self.ist, self.fst)
 
     def recompute_forces(self) -> float:
         """Recompute a = -K u - g theta(0) from the displacements (sparse mat-vec).
@@ -345,7 +345,7 @@ class Realization:
                 thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
                 self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, sc.recompute_every,
                 o["indptr"], o["indices"], o["kdata"], o["kdiag"], o["g"], o["normal_load"],
-                o["w"], self.hp, self.hpos, self.hkey, self.aval_hist, self.node_slips,
+                o["w"], self.hp, self.hv, self.hpos, self.aval_hist, self.node_slips,
                 out["n"], out["mu_max"], out["x_G"], out["n_records"], out["f_sum"],
                 out["f_sq"], out["f_count"],
             )
@@ -353,7 +353,7 @@ class Realization:
             thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
             sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
             o["indices"], o["kblk"], o["diagpos"], o["g"], o["driven"], o["normal_load"], o["w"], self.hp,
-            self.hpos, self.hkey, self.aval_hist, self.node_slips, out["n"], out["mu_max"],
+            self.hv, self.hpos, self.aval_hist, self.node_slips, out["n"], out["mu_max"],
             out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
         )
 

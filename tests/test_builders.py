@@ -182,6 +182,25 @@ def test_stiffness_symmetric_positive_semidefinite(make):
     assert eig.min() > -1e-10 * eig.max()
 
 
+@pytest.mark.parametrize("make", [
+    *NETWORKS_2D, pytest.param(lambda: chain(7, NT, k=np.arange(1.0, 7.0)), id="chain-7-graded"),
+])
+def test_block_assembly_equals_the_sparse_product(make):
+    """The compiled row-by-row assembly gives B^T diag(k) B, with sorted rows holding K_ii."""
+    net = make()
+    K = net.stiffness_blocks()
+    np.testing.assert_allclose(K.toarray(), net.stiffness_matrix().toarray(), rtol=1e-15, atol=1e-15)
+    rows = np.repeat(np.arange(net.n_nodes), np.diff(K.indptr))
+    assert (np.diff(K.indices)[np.diff(rows) == 0] > 0).all()
+    assert np.bincount(rows[K.indices == rows], minlength=net.n_nodes).tolist() == [1] * net.n_nodes
+
+
+def test_parallel_springs_are_summed():
+    net = Network(positions=[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], edges=[[0, 1], [1, 0], [0, 2]], Ntilde=NT)
+    np.testing.assert_allclose(net.stiffness_blocks().toarray(), net.stiffness_matrix().toarray())
+    assert net.stiffness_blocks().toarray()[0, 0] == 2.0
+
+
 @pytest.mark.parametrize(("make", "zero_modes"), [
     pytest.param(lambda: triangular((4, 5), NT), 3, id="triangular-4x5"),
     pytest.param(lambda: triangular((2, 2), NT), 3, id="triangular-2x2"),

@@ -9,8 +9,6 @@ these only change when the node or a neighbour slips.
 
 from __future__ import annotations
 
-from numba import njit
-
 from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
 from slidernet.kernels.state import (
     AV_SLIPS,
@@ -31,17 +29,20 @@ from slidernet.kernels.state import (
     UP_SIZE,
     XG,
     Q,
+    kernel_jit,
     write_record,
 )
 from slidernet.kernels.tilt import tilt_sample
 
 
-@njit(cache=True)
-def update_node(j, theta, a, g, mu, normal_load, hp, hpos, hkey, ist):
+@kernel_jit(inline="always")
+def update_node(j, theta, a, g, mu, normal_load, hp, hv, hpos, ist):
     """Re-key node j in the three heaps after its force or threshold changed."""
-    F = a[j] + g[j] * theta
+    F = abs(a[j] + g[j] * theta)
     lim = mu[j] * normal_load[j]
-    heap_set(j, abs(F) / lim, abs(F) > lim, hp, hpos, hkey, 0, ist, HEAP_SIZE)
+    # Most updated nodes are stable and out of the heap: skip the call then.
+    if F > lim or hpos[j, 0] >= 0:
+        heap_set(j, F / lim, F > lim, hp, hv, hpos, 0, ist, HEAP_SIZE)
     gj = g[j]
     if gj != 0.0:
         # The two roots of |a_j + g_j theta| = mu_s,j N_j.
@@ -51,12 +52,12 @@ def update_node(j, theta, a, g, mu, normal_load, hp, hpos, hkey, ist):
         else:
             up = (-lim - a[j]) / gj
             dn = (lim - a[j]) / gj
-        heap_set(j, -up, True, hp, hpos, hkey, 1, ist, UP_SIZE)
-        heap_set(j, dn, True, hp, hpos, hkey, 2, ist, DOWN_SIZE)
+        heap_set(j, -up, True, hp, hv, hpos, 1, ist, UP_SIZE)
+        heap_set(j, dn, True, hp, hv, hpos, 2, ist, DOWN_SIZE)
 
 
-@njit(cache=True)
-def init_csr_heaps(a, g, mu, normal_load, hp, hpos, hkey, ist, fst):
+@kernel_jit()
+def init_csr_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
     """(Re)build the three heaps from scratch, O(N log N)."""
     hpos[:] = -1
     ist[HEAP_SIZE] = 0
@@ -64,12 +65,12 @@ def init_csr_heaps(a, g, mu, normal_load, hp, hpos, hkey, ist, fst):
     ist[DOWN_SIZE] = 0
     theta = fst[THETA]
     for j in range(mu.size):
-        update_node(j, theta, a, g, mu, normal_load, hp, hpos, hkey, ist)
+        update_node(j, theta, a, g, mu, normal_load, hp, hv, hpos, ist)
 
 
-@njit(cache=True)
+@kernel_jit()
 def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
-          ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips):
+          ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips):
     """Node i slips alone (undamped half-oscillation); its threshold is redrawn."""
     sgn = 1.0 if Fi > 0.0 else -1.0
     du = 2.0 * (absF - mu_d * normal_load[i]) * sgn / kdiag[i]
@@ -80,13 +81,13 @@ def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, 
     redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
     theta = fst[THETA]
     for p in range(indptr[i], indptr[i + 1]):
-        update_node(indices[p], theta, a, g, mu, normal_load, hp, hpos, hkey, ist)
+        update_node(indices[p], theta, a, g, mu, normal_load, hp, hv, hpos, ist)
 
 
-@njit(cache=True)
+@kernel_jit()
 def run_csr(
     thetas, rec_times, mu, ist, fst, a, u, mu_buf, tmu, tu, mu_d, do_tilt, max_slips,
-    recompute_every, indptr, indices, kdata, kdiag, g, normal_load, w, hp, hpos, hkey,
+    recompute_every, indptr, indices, kdata, kdiag, g, normal_load, w, hp, hv, hpos,
     aval_hist, node_slips, out_n, out_mu_max, out_xg, out_records, fsum, fsq, fcount,
 ):
     """Advance a 1D network through ``thetas`` (units of Ntilde).
@@ -127,7 +128,7 @@ def run_csr(
                     ist[AV_SLIPS] -= 1
                     return st
             _slip(i, Fi, abs(Fi), a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
-                  ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips)
+                  ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips)
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
@@ -139,10 +140,10 @@ def run_csr(
         best = -1
         if s > 0.0 and ist[UP_SIZE] > 0:
             best = hp[1, 0]
-            thc = -hkey[1, best]
+            thc = -hv[1, 0]
         elif s < 0.0 and ist[DOWN_SIZE] > 0:
             best = hp[2, 0]
-            thc = hkey[2, best]
+            thc = hv[2, 0]
         if best >= 0:
             theta = fst[THETA]
             if s * (thc - theta) < 0.0:
@@ -164,7 +165,7 @@ def run_csr(
                 ist[IN_AVALANCHE] = 1
                 ist[N_EVENTS] += 1
                 _slip(best, sigma * lim, lim, a, u, mu, indptr, indices, kdata, kdiag, g,
-                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hpos, hkey, node_slips)
+                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips)
                 continue
         ist[Q] = q + 1
         fst[THETA] = theta_b

@@ -1,8 +1,8 @@
 """Indexed binary max-heaps for the event engine, and the bookkeeping of a slip.
 
-A heap holds node indices ordered by a per-node ``key`` (largest first, ties
+A heap holds node indices ordered by a per-node key (largest first, ties
 to the lowest node index, which is the documented tie rule of MODEL.md).
-``pos[node]`` is the node's slot in the heap or -1, so that re-keying or
+``hpos[node, w]`` is the node's slot in heap w or -1, so that re-keying or
 removing a node costs O(log size). Its size lives in ``ist[slot]``.
 
 The kernels use three heaps: unstable nodes keyed by overload
@@ -14,8 +14,6 @@ min-heap on theta_up is a max-heap on -theta_up with the same tie rule.
 
 from __future__ import annotations
 
-from numba import njit
-
 from slidernet.kernels.state import (
     ARGMAX,
     MU_MAX,
@@ -23,87 +21,91 @@ from slidernet.kernels.state import (
     N_RECORDS,
     N_SLIPS,
     SINCE_RECOMPUTE,
+    kernel_jit,
 )
 
 
-@njit(cache=True, inline="always")
+@kernel_jit(inline="always")
 def _before(ka, na, kb, nb):
     return ka > kb or (ka == kb and na < nb)
 
 
-# The heaps are rows w of 2D arrays (hp, hpos, hkey), indexed in place: slicing
-# a row would build a new array object at every call of the hot loop.
+# The heaps are rows w of 2D arrays, indexed in place (slicing a row would
+# build a new array object at every call of the hot loop): hp[w, h] is the
+# node in slot h and hv[w, h] its key, so that sifting reads contiguous
+# memory; hpos[node, w] is the slot of a node, node-major so that the three
+# slots of a node share a cache line.
 
 
-@njit(cache=True, inline="always")
-def _swap(hp, hpos, w, a, b):
-    na = hp[w, a]
-    nb = hp[w, b]
-    hp[w, a] = nb
-    hp[w, b] = na
-    hpos[w, nb] = a
-    hpos[w, na] = b
+@kernel_jit(inline="always")
+def _place(hp, hv, hpos, w, h, node, key):
+    hp[w, h] = node
+    hv[w, h] = key
+    hpos[node, w] = h
 
 
-@njit(cache=True)
-def _up(hp, hpos, hkey, w, h):
+@kernel_jit()
+def _up(hp, hv, hpos, w, h):
+    node = hp[w, h]
+    key = hv[w, h]
     while h > 0:
         p = (h - 1) >> 1
-        if _before(hkey[w, hp[w, h]], hp[w, h], hkey[w, hp[w, p]], hp[w, p]):
-            _swap(hp, hpos, w, h, p)
-            h = p
-        else:
+        if not _before(key, node, hv[w, p], hp[w, p]):
             break
+        _place(hp, hv, hpos, w, h, hp[w, p], hv[w, p])
+        h = p
+    _place(hp, hv, hpos, w, h, node, key)
+    return h
 
 
-@njit(cache=True)
-def _down(hp, hpos, hkey, w, h, size):
+@kernel_jit()
+def _down(hp, hv, hpos, w, h, size):
+    node = hp[w, h]
+    key = hv[w, h]
     while True:
         c = 2 * h + 1
         if c >= size:
             break
-        if c + 1 < size and _before(hkey[w, hp[w, c + 1]], hp[w, c + 1], hkey[w, hp[w, c]], hp[w, c]):
+        if c + 1 < size and _before(hv[w, c + 1], hp[w, c + 1], hv[w, c], hp[w, c]):
             c += 1
-        if _before(hkey[w, hp[w, c]], hp[w, c], hkey[w, hp[w, h]], hp[w, h]):
-            _swap(hp, hpos, w, h, c)
-            h = c
-        else:
+        if not _before(hv[w, c], hp[w, c], key, node):
             break
+        _place(hp, hv, hpos, w, h, hp[w, c], hv[w, c])
+        h = c
+    _place(hp, hv, hpos, w, h, node, key)
 
 
-@njit(cache=True)
-def heap_set(node, value, present, hp, hpos, hkey, w, ist, slot):
+@kernel_jit()
+def heap_set(node, value, present, hp, hv, hpos, w, ist, slot):
     """In heap ``w``: insert ``node`` with key ``value``, re-key it, or (``present`` False) remove it.
 
     The heap's size lives in ``ist[slot]``.
     """
-    h = hpos[w, node]
+    h = hpos[node, w]
     if present:
-        if h >= 0 and hkey[w, node] == value:
-            return
-        hkey[w, node] = value
-        if h < 0:
-            size = ist[slot]
-            hp[w, size] = node
-            hpos[w, node] = size
-            ist[slot] = size + 1
-            _up(hp, hpos, hkey, w, size)
+        if h >= 0:
+            if hv[w, h] == value:
+                return
+            hv[w, h] = value
+            h2 = _up(hp, hv, hpos, w, h)
+            if h2 == h:
+                _down(hp, hv, hpos, w, h, ist[slot])
         else:
-            _up(hp, hpos, hkey, w, h)
-            _down(hp, hpos, hkey, w, hpos[w, node], ist[slot])
+            size = ist[slot]
+            _place(hp, hv, hpos, w, size, node, value)
+            ist[slot] = size + 1
+            _up(hp, hv, hpos, w, size)
     elif h >= 0:
         last = ist[slot] - 1
         ist[slot] = last
-        hpos[w, node] = -1
+        hpos[node, w] = -1
         if h != last:
-            moved = hp[w, last]
-            hp[w, h] = moved
-            hpos[w, moved] = h
-            _up(hp, hpos, hkey, w, h)
-            _down(hp, hpos, hkey, w, hpos[w, moved], last)
+            _place(hp, hv, hpos, w, h, hp[w, last], hv[w, last])
+            if _up(hp, hv, hpos, w, h) == h:
+                _down(hp, hv, hpos, w, h, last)
 
 
-@njit(cache=True)
+@kernel_jit()
 def avalanche_done(ist, aval_hist, av_slot, flag_slot):
     """Close the current avalanche: bin its size (slips) by floor(log2 size)."""
     if ist[flag_slot]:
@@ -116,7 +118,7 @@ def avalanche_done(ist, aval_hist, av_slot, flag_slot):
         ist[flag_slot] = 0
 
 
-@njit(cache=True)
+@kernel_jit()
 def redraw_threshold(i, mu, mu_buf, ist, fst, node_slips):
     """After node i slipped: draw its new mu_s, keep mu_max and its holder, count the slip.
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from numba import njit
-
 from slidernet.kernels.state import (
     AV_SLIPS,
     AVALANCHE_LIMIT,
@@ -22,12 +20,13 @@ from slidernet.kernels.state import (
     XG,
     Q,
     U,
+    kernel_jit,
     write_record,
 )
 from slidernet.kernels.tilt import tilt_sample
 
 
-@njit(cache=True)
+@kernel_jit()
 def run_pair(
     thetas, rec_times, mu, ist, fst, mu_buf, tmu, tu, mu_d, do_tilt, max_slips,
     out_n, out_mu_max, out_xg, out_records, fsum, fsq, fcount,

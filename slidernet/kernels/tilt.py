@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from numba import njit
-
-from slidernet.kernels.state import DONE, NEED_TILT, TILT_LIMIT, TILT_MAX_ITER, TMU_POS, TU_POS
+from slidernet.kernels.state import DONE, NEED_TILT, TILT_LIMIT, TILT_MAX_ITER, TMU_POS, TU_POS, kernel_jit
 
 
-@njit(cache=True)
+@kernel_jit()
 def tilt_test_pair(F, mu1, mu2, mu_d, tmu, tu, ist):
     """The appendix's virtual tilt test on a copy of (F, mu1, mu2).
 
@@ -57,7 +55,7 @@ def tilt_test_pair(F, mu1, mu2, mu_d, tmu, tu, ist):
     return -2.0
 
 
-@njit(cache=True)
+@kernel_jit()
 def tilt_sample(F, mu1, mu2, mu_d, tmu, tu, ist, k, fsum, fsq, fcount):
     """Run one tilt test and add its sample to record bin ``k``; returns a status."""
     f = tilt_test_pair(F, mu1, mu2, mu_d, tmu, tu, ist)

@@ -22,9 +22,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
-
 from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
 from slidernet.kernels.state import (
     AV_SLIPS,
@@ -49,6 +46,7 @@ from slidernet.kernels.state import (
     XG,
     YG,
     Q,
+    kernel_jit,
 )
 
 SLIP_STRAIGHT = 0
@@ -57,7 +55,7 @@ _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
 
 
-@njit(cache=True)
+@kernel_jit()
 def critical_thetas(ax, ay, gx, gy, lim):
     """Roots (theta_dn, theta_up) of |a + g theta| = lim, in the numerically stable form."""
     A = gx * gx + gy * gy
@@ -81,7 +79,7 @@ def critical_thetas(ax, ay, gx, gy, lim):
     return min(r1, r2), max(r1, r2)
 
 
-@njit(cache=True)
+@kernel_jit()
 def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
     """Displacement of a node sliding from rest under F - K x and friction fd (2D, unit mass).
 
@@ -140,7 +138,7 @@ def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
     return x, y, -1
 
 
-@njit(cache=True, inline="always")
+@kernel_jit(inline="always")
 def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd, px, py):
     ex = px
     ey = py
@@ -151,34 +149,37 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd, px, py):
     return Fx - (kxx * x + kxy * y) - fd * ex, Fy - (kxy * x + kyy * y) - fd * ey
 
 
-@njit(cache=True)
-def update_node(j, theta, a, g, driven, mu, normal_load, hp, hpos, hkey, ist):
+@kernel_jit(inline="always")
+def update_node(j, theta, a, g, driven, mu, normal_load, hp, hv, hpos, ist):
     """Re-key node j in the three heaps after its force or threshold changed."""
     Fx = a[j, 0] + g[j, 0] * theta
     Fy = a[j, 1] + g[j, 1] * theta
-    F = math.hypot(Fx, Fy)
+    F2 = Fx * Fx + Fy * Fy  # forces are O(1) in these units: no overflow, hypot not needed
     lim = mu[j] * normal_load[j]
-    heap_set(j, F / lim, F > lim, hp, hpos, hkey, 0, ist, HEAP_SIZE)
+    # Most updated nodes are stable and out of the heap: skip the call then.
+    if F2 > lim * lim or hpos[j, 0] >= 0:
+        F = math.sqrt(F2)
+        heap_set(j, F / lim, F > lim, hp, hv, hpos, 0, ist, HEAP_SIZE)
     if driven[j]:
         dn, up = critical_thetas(a[j, 0], a[j, 1], g[j, 0], g[j, 1], lim)
-        heap_set(j, -up, True, hp, hpos, hkey, 1, ist, UP_SIZE)
-        heap_set(j, dn, True, hp, hpos, hkey, 2, ist, DOWN_SIZE)
+        heap_set(j, -up, True, hp, hv, hpos, 1, ist, UP_SIZE)
+        heap_set(j, dn, True, hp, hv, hpos, 2, ist, DOWN_SIZE)
 
 
-@njit(cache=True)
-def init_vec_heaps(a, g, driven, mu, normal_load, hp, hpos, hkey, ist, fst):
+@kernel_jit()
+def init_vec_heaps(a, g, driven, mu, normal_load, hp, hv, hpos, ist, fst):
     """(Re)build the three heaps from scratch, O(N log N)."""
     hpos[:] = -1
     ist[HEAP_SIZE] = 0
     ist[UP_SIZE] = 0
     ist[DOWN_SIZE] = 0
     for j in range(mu.size):
-        update_node(j, fst[THETA], a, g, driven, mu, normal_load, hp, hpos, hkey, ist)
+        update_node(j, fst[THETA], a, g, driven, mu, normal_load, hp, hv, hpos, ist)
 
 
-@njit(cache=True)
+@kernel_jit()
 def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load, w,
-          ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey, node_slips):
+          ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips):
     """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
     fd = mu_d * normal_load[i]
     d = diagpos[i]  # the diagonal block K_ii
@@ -208,11 +209,11 @@ def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, 
     redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
     theta = fst[THETA]
     for p in range(indptr[i], indptr[i + 1]):
-        update_node(indices[p], theta, a, g, driven, mu, normal_load, hp, hpos, hkey, ist)
+        update_node(indices[p], theta, a, g, driven, mu, normal_load, hp, hv, hpos, ist)
     return True
 
 
-@njit(cache=True)
+@kernel_jit()
 def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min):
     k = ist[REC]
     out_n[k] = ist[N_SLIPS]
@@ -221,15 +222,20 @@ def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu
     out_yg[k] = fst[YG]
     out_records[k] = ist[N_RECORDS]
     # O(N) at record times only (log-spaced by default).
-    out_mu_mean[k] = np.mean(mu)
-    out_mu_min[k] = np.min(mu)
+    total = 0.0
+    low = mu[0]
+    for j in range(mu.size):
+        total += mu[j]
+        low = min(low, mu[j])
+    out_mu_mean[k] = total / mu.size
+    out_mu_min[k] = low
     ist[REC] = k + 1
 
 
-@njit(cache=True)
+@kernel_jit()
 def run_vec(
     thetas, rec_times, mu, ist, fst, a, u, mu_buf, mu_d, max_slips, recompute_every, slip_mode,
-    indptr, indices, kblk, diagpos, g, driven, normal_load, w, hp, hpos, hkey, aval_hist,
+    indptr, indices, kblk, diagpos, g, driven, normal_load, w, hp, hv, hpos, aval_hist,
     node_slips, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
 ):
     """Advance a 2D network through ``thetas`` (units of Ntilde).
@@ -261,9 +267,9 @@ def run_vec(
             if ist[MU_POS] >= mu_buf.size:
                 ist[AV_SLIPS] -= 1
                 return NEED_MU
-            if not _slip(i, Fx, Fy, math.hypot(Fx, Fy), a, u, mu, indptr, indices, kblk, diagpos, g, driven,
-                         normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey,
-                         node_slips):
+            absF = math.sqrt(Fx * Fx + Fy * Fy)
+            if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load,
+                         w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips):
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
@@ -283,10 +289,10 @@ def run_vec(
         best = -1
         if s > 0.0 and ist[UP_SIZE] > 0:
             best = hp[1, 0]
-            thc = -hkey[1, best]
+            thc = -hv[1, 0]
         elif s < 0.0 and ist[DOWN_SIZE] > 0:
             best = hp[2, 0]
-            thc = hkey[2, best]
+            thc = hv[2, 0]
         if best >= 0:
             theta = fst[THETA]
             if s * (thc - theta) < 0.0:
@@ -303,7 +309,7 @@ def run_vec(
                 ist[IN_AVALANCHE] = 1
                 ist[N_EVENTS] += 1
                 if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g, driven,
-                             normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hpos, hkey,
+                             normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
                              node_slips):
                     ist[ERR_NODE] = best
                     return AVALANCHE_LIMIT
