@@ -10,7 +10,8 @@ order for :func:`irregular`; springs are listed as pairs ``(i, j)`` with
 Keyword ``overrides`` (``k``, ``kappa``, ``normal_load``, ``rest_length``) are
 passed on to :class:`~slidernet.network.Network`: a scalar for every spring
 (or slider), or an array with one value per spring (shape (E,)) or per slider
-(shape (N,)), in that network's order.
+(shape (N,)), in that network's order. ``f_ext``, the constant external force
+on each slider, is a number (along x), a d-vector, or one per slider (N, d).
 
 :func:`build` is the entry point of the configuration layer::
 
@@ -66,7 +67,8 @@ KINDS: dict[str, tuple[str, ...]] = {
 }
 
 # Per-spring or per-slider values a builder passes on to Network.
-_OVERRIDES: dict[str, str] = {"k": "edge", "kappa": "edge", "rest_length": "edge", "normal_load": "node"}
+_OVERRIDES: dict[str, str] = {"k": "edge", "kappa": "edge", "rest_length": "edge", "normal_load": "node",
+                              "f_ext": "node vector"}
 
 _EDGE_LIST_SUFFIXES = (".edgelist", ".txt", ".csv")
 _GRAPH_SUFFIXES = (".graphml", *_EDGE_LIST_SUFFIXES)
@@ -90,6 +92,8 @@ def _check_overrides(overrides: Mapping[str, Any], n_nodes: int, n_edges: int, o
                 f"{', '.join(repr(o) for o in _OVERRIDES)}."
             )
         if value is None and name == "rest_length":  # None means geometric, as in Network
+            continue
+        if _OVERRIDES[name] == "node vector":  # Network checks its several accepted shapes
             continue
         size, item = (n_edges, "spring") if _OVERRIDES[name] == "edge" else (n_nodes, "slider")
         shape = np.shape(value)
@@ -665,8 +669,14 @@ def write_graph(net: Network, path: str | PathLike[str]) -> list[Path]:
         G = net.to_networkx()
         for _, data in G.nodes(data=True):
             data.update(zip(axes, data.pop("pos"), strict=True))
+            if "f_ext" in data:  # GraphML attributes are scalars
+                data.update(zip(("f_ext_x", "f_ext_y"), data.pop("f_ext"), strict=False))
         nx.write_graphml(G, p)
         return [p]
+    if net.f_ext.any():
+        # Refused rather than dropped: the edge-list formats have no column for it.
+        raise ConfigError(f"{str(p)!r}: an edge list cannot store the network's external forces f_ext; "
+                          "write a '.graphml' file instead.")
     nodes = _nodes_file(p)
     with nodes.open("w", newline="") as f:
         w = csv.writer(f)

@@ -42,6 +42,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records")
 
 
@@ -80,7 +81,9 @@ class NetworkConfig(_Strict):
     geometry is quenched, the same for every realization) and ``graph``
     (``path`` of a GraphML or edge-list file). ``k`` (in units of
     N / (Ntilde l0)), ``kappa`` and ``normal_load`` (in units of N) replace
-    the default 1 on every spring or node.
+    the default 1 on every spring or node. ``f_ext`` (in units of N) is a
+    constant external tangential force on every slider: a number is a force
+    along x, ``[fx, fy]`` a 2D force (2D networks only); default 0.
     """
 
     kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = "two_slider"
@@ -92,6 +95,7 @@ class NetworkConfig(_Strict):
     k: PositiveFloat | None = None
     kappa: Annotated[float, Field(allow_inf_nan=False)] | None = None
     normal_load: PositiveFloat | None = None
+    f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = None
 
     @model_validator(mode="after")
     def _params_match_kind(self) -> NetworkConfig:
@@ -107,7 +111,15 @@ class NetworkConfig(_Strict):
             raise ValueError(f"a {self.kind} network needs {sorted(missing)}")
         if self.shape is not None and self.shape[0] * self.shape[1] < 2:
             raise ValueError(f"shape {list(self.shape)} has fewer than 2 sliders")
+        if isinstance(self.f_ext, tuple) and self.kind in ("two_slider", "chain"):
+            raise ValueError(f"a {self.kind} network is 1D: 'f_ext' must be a number (the force along x), "
+                             f"not {list(self.f_ext)}")
         return self
+
+    def pair_tilt_applies(self) -> bool:
+        """True if the appendix's two-slider tilt test applies (when known without a file)."""
+        return (self.kind == "two_slider" or (self.kind == "chain" and self.n == 2)) \
+            and self.normal_load in (None, 1.0) and not self.f_ext
 
     def size(self) -> int | None:
         """Number of sliders, when known without reading a file."""
@@ -144,7 +156,14 @@ class SolverConfig(_Strict):
 
 
 class Config(_Strict):
-    """A full run: what to simulate, for how long, and what to record."""
+    """A full run: what to simulate, for how long, and what to record.
+
+    ``mu_eff_at`` says when the virtual tilt test of ``mu_eff`` is made:
+    ``"rearrangements"`` before every rearrangement (the appendix; a 1D pair
+    of sliders), ``"records"`` once per realization at every recorded time
+    (the network tilt test, any network), ``"auto"`` the first where it
+    applies and the second otherwise.
+    """
 
     seed: Annotated[int, Field(ge=0)] | None = None
     realizations: Annotated[int, Field(ge=1)] = 1
@@ -154,6 +173,7 @@ class Config(_Strict):
     observables: list[Literal["n", "mu_max", "x_G", "mu_eff", "n_records"]] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"]
     )
+    mu_eff_at: Literal["auto", "rearrangements", "records"] = "auto"
     network: NetworkConfig
     friction: FrictionConfig
     driver: PluginSpec
@@ -168,10 +188,11 @@ class Config(_Strict):
             if any(t > self.steps for t in self.record):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         size = self.network.size()
-        if "mu_eff" in self.observables and size not in (2, None):
+        if self.mu_eff_at == "rearrangements" and not self.network.pair_tilt_applies():
             raise ValueError(
-                "the 'mu_eff' observable (the appendix's tilt test) is defined for 2 sliders; "
-                f"this network has {size}"
+                "'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every rearrangement) "
+                "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records' "
+                "(the network tilt test at the recorded times)"
             )
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")

@@ -42,6 +42,27 @@ def _per_item(value, size: int, name: str, owner: str) -> np.ndarray:
     return arr
 
 
+def _per_node_vector(value, n: int, d: int, name: str, owner: str) -> np.ndarray:
+    """A per-node vector field of shape (N, d) from a number (along x), a d-vector, (N,) or (N, d)."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        out = np.zeros((n, d))
+        out[:, 0] = arr
+    elif arr.shape == (d,) and n != d:
+        out = np.broadcast_to(arr, (n, d)).copy()
+    elif arr.shape == (n,) and d == 1:
+        out = arr[:, None].copy()
+    elif arr.shape == (n, d):
+        out = arr.copy()
+    else:
+        wanted = f"a number or one per slider (shape ({n},))" if d == 1 else \
+            f"a number (along x), a vector of {d} components, or one per slider (shape ({n}, {d}))"
+        raise param_error(name, owner, wanted, f"an array of shape {arr.shape}")
+    if not np.isfinite(out).all():
+        raise param_error(name, owner, "finite", value)
+    return out
+
+
 class Network:
     """A 1D or 2D network of sliders joined by linear springs.
 
@@ -66,6 +87,12 @@ class Network:
         The initial state is at rest whatever it is.
     normal_load : float or array_like, shape (N,)
         Normal loads N_i in units of N (default 1); they also weight x_G.
+    f_ext : float or array_like, shape (d,), (N,) or (N, d)
+        Constant external tangential force on each slider, in units of N
+        (default 0): a number is the same force along x on every slider, a
+        d-vector the same force on every slider, an (N,) or (N, d) array one
+        force per slider. A tilt by an angle alpha is
+        ``f_ext = tan(alpha) * normal_load`` along the slope.
 
     Examples
     --------
@@ -87,6 +114,7 @@ class Network:
         kappa: float | Sequence[float] = 1.0,
         normal_load: float | Sequence[float] = 1.0,
         rest_length: float | Sequence[float] | None = None,
+        f_ext: float | Sequence[float] | np.ndarray = 0.0,
     ) -> None:
         owner = "Network"
         Ntilde = float(Ntilde)
@@ -132,6 +160,7 @@ class Network:
         self.normal_load = _per_item(normal_load, x.shape[0], "normal_load", owner)
         if (self.normal_load <= 0).any():
             raise param_error("normal_load", owner, "> 0 for every slider", normal_load)
+        self.f_ext = _per_node_vector(f_ext, x.shape[0], x.shape[1], "f_ext", owner)
         if rest_length is None:
             self.rest_length = length
         else:
@@ -237,18 +266,22 @@ class Network:
             and tuple(self.edges[0]) == (0, 1)
             and bool((self.k == 1.0).all() and (self.kappa == 1.0).all())
             and bool((self.normal_load == 1.0).all())
+            and not self.f_ext.any()
         )
 
     def to_networkx(self) -> nx.Graph:
         """The network as a networkx graph.
 
-        Node attributes: ``pos`` (a tuple of d floats, in l0) and
-        ``normal_load``; edge attributes: ``k``, ``kappa``, ``rest_length``.
+        Node attributes: ``pos`` (a tuple of d floats, in l0),
+        ``normal_load`` and, where it is not zero, ``f_ext`` (a tuple of d
+        floats, in N); edge attributes: ``k``, ``kappa``, ``rest_length``.
         """
         G = nx.Graph()
         for i in range(self.n_nodes):
             G.add_node(i, pos=tuple(float(c) for c in self.positions[i]),
                        normal_load=float(self.normal_load[i]))
+            if self.f_ext[i].any():
+                G.nodes[i]["f_ext"] = tuple(float(c) for c in self.f_ext[i])
         for e, (i, j) in enumerate(self.edges):
             G.add_edge(int(i), int(j), k=float(self.k[e]), kappa=float(self.kappa[e]),
                        rest_length=float(self.rest_length[e]))
@@ -260,9 +293,10 @@ class Network:
 
         A node's position is its ``pos`` attribute (a sequence of 1 or 2
         floats) or its ``x`` (and ``y``) attributes. Optional attributes:
-        ``normal_load`` on nodes; ``k``, ``kappa`` and ``rest_length`` on
-        edges. Nodes are numbered in ``G.nodes`` order. Keyword ``overrides``
-        (``k``, ``kappa``, ``normal_load``, ``rest_length``) replace the
+        ``normal_load`` and ``f_ext`` (a number along x, or d floats; or
+        ``f_ext_x`` and ``f_ext_y``) on nodes; ``k``, ``kappa`` and ``rest_length`` on edges. Nodes are
+        numbered in ``G.nodes`` order. Keyword ``overrides`` (``k``,
+        ``kappa``, ``normal_load``, ``rest_length``, ``f_ext``) replace the
         attributes for every node or edge.
         """
         nodes = list(G.nodes)
@@ -285,6 +319,9 @@ class Network:
             "kappa": [float(d.get("kappa", 1.0)) for d in edata],
             "normal_load": [float(G.nodes[v].get("normal_load", 1.0)) for v in nodes],
         }
+        if any(key in G.nodes[v] for v in nodes for key in ("f_ext", "f_ext_x", "f_ext_y")):
+            d = len(positions[0])
+            attrs["f_ext"] = [_node_force(G.nodes[v], d, v) for v in nodes]
         if any("rest_length" in d for d in edata):
             geometric = np.linalg.norm(np.subtract([positions[b] for _, b in edges],
                                                    [positions[a] for a, _ in edges]), axis=1)
@@ -295,6 +332,21 @@ class Network:
 
     def __repr__(self) -> str:
         return f"Network(N={self.n_nodes}, E={self.n_edges}, Ntilde={self.Ntilde!r})"
+
+
+def _node_force(data: dict, d: int, node) -> list[float]:
+    """A node's external force as d floats, from ``f_ext`` (a number along x, or d numbers)
+    or from ``f_ext_x`` and ``f_ext_y`` (GraphML attributes are scalars)."""
+    if "f_ext" not in data:
+        return [float(data.get("f_ext_x", 0.0)), float(data.get("f_ext_y", 0.0))][:d]
+    value = data["f_ext"]
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.size == 1:
+        return [float(arr[0])] + [0.0] * (d - 1)
+    if arr.size != d:
+        raise ConfigError(f"The 'f_ext' attribute of node {node!r} must be a number or {d} numbers. "
+                          f"Got {value!r} instead.")
+    return [float(c) for c in arr]
 
 
 def chain(n: int, Ntilde: float, **overrides) -> Network:

@@ -122,13 +122,25 @@ class Scene:
     steps: int
     rec_times: np.ndarray
     kernel: str
-    do_tilt: bool
+    tilt_at: str | None
     max_avalanche: int
     batch: int
     recompute_every: int
     slip_mode: int
     ops: dict[str, np.ndarray] = field(default_factory=dict)
     K: Any = None
+    _tilt_ops: dict[str, Any] | None = field(default=None, repr=False)
+
+    @property
+    def do_tilt(self) -> bool:
+        """True if the kernel makes the appendix's tilt test before every rearrangement."""
+        return self.tilt_at == "rearrangements"
+
+    def tilt_ops(self) -> dict[str, Any]:
+        """The arrays of the network tilt test (built on first use; 1D padded to 2D)."""
+        if self._tilt_ops is None:
+            self._tilt_ops = _tilt_operators(self.network)
+        return self._tilt_ops
 
     @classmethod
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
@@ -142,11 +154,15 @@ class Scene:
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
             )
-        if "mu_eff" in cfg.observables and net.n_nodes != 2:
-            raise ConfigError(
-                "The 'observables' field: 'mu_eff' (the appendix's tilt test) is defined for 2 "
-                f"sliders; this network has {net.n_nodes}."
-            )
+        tilt_at = None
+        if "mu_eff" in cfg.observables:
+            pair = pair_tilt_applies(net)
+            tilt_at = cfg.mu_eff_at if cfg.mu_eff_at != "auto" else ("rearrangements" if pair else "records")
+            if tilt_at == "rearrangements" and not pair:
+                raise ConfigError(
+                    "The 'mu_eff_at' field: the tilt test before every rearrangement (the appendix) "
+                    "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records'."
+                )
         return cls(
             network=net,
             distribution=cfg.distribution(),
@@ -157,7 +173,7 @@ class Scene:
             steps=cfg.steps,
             rec_times=record_times(cfg.steps, cfg.record, cfg.log_points_per_decade),
             kernel=kernel,
-            do_tilt="mu_eff" in cfg.observables,
+            tilt_at=tilt_at,
             max_avalanche=cfg.solver.max_avalanche,
             batch=cfg.solver.batch,
             recompute_every=cfg.solver.recompute_every,
@@ -165,6 +181,44 @@ class Scene:
             ops=ops,
             K=K,
         )
+
+
+def pair_tilt_applies(net: Network) -> bool:
+    """True if the appendix's two-slider tilt test (``kernels.tilt_test_pair``) applies to ``net``.
+
+    It is written for two sliders of unit normal load on a line, with no force
+    but the spring's.
+    """
+    return (net.n_nodes == 2 and net.dim == 1 and bool((net.normal_load == 1.0).all())
+            and not net.f_ext.any())
+
+
+def _tilt_operators(net: Network) -> dict[str, Any]:
+    """Block-CSR rows of K with 2 x 2 blocks (1D padded with zeros) for the network tilt test."""
+    K = net.stiffness_blocks()
+    indptr = K.indptr.astype(np.int64)
+    indices = K.indices.astype(np.int64)
+    blocks = np.zeros((indices.size, 2, 2))
+    d = net.dim
+    blocks[:, :d, :d] = K.data
+    row = np.repeat(np.arange(net.n_nodes), np.diff(indptr))
+    f_ext = np.zeros((net.n_nodes, 2))
+    f_ext[:, :d] = net.f_ext
+    return {
+        "indptr": indptr,
+        "indices": indices,
+        "kblk": blocks,
+        "diagpos": np.flatnonzero(indices == row).astype(np.int64),
+        "f_ext": f_ext,
+        "f_bar": float(f_ext[:, 0].sum() / net.normal_load.sum()),
+        "pair_rule": net.n_nodes == 2 and d == 1,
+    }
+
+
+def tilt_avalanche_cap(n_nodes: int) -> int:
+    """Slips of one tilt-test avalanche after which a part of the network slides alone (rule 4 of
+    :mod:`slidernet.kernels.tilt_net`): 100 slips per node, and at least 1e5."""
+    return max(100 * n_nodes, 100_000)
 
 
 def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random.Generator]:
@@ -225,7 +279,7 @@ class Realization:
         dist = scene.distribution
         self.mu = dist.sample(self.rngs["thresholds"], net.n_nodes).astype(np.float64)
         self.mu_buf = dist.sample(self.rngs["thresholds"], scene.batch)
-        if scene.do_tilt:
+        if scene.tilt_at is not None:
             self.tmu = dist.sample(self.rngs["tilt"], scene.batch)
             self.tu = self.rngs["tilt"].random(scene.batch)
         else:
@@ -241,6 +295,8 @@ class Realization:
             "f_sq": np.zeros(T),
             "f_count": np.zeros(T, np.int64),
         }
+        self._tilted = 0  # recorded times whose network tilt test is done
+        self._tilt_work: tuple[np.ndarray, ...] | None = None
         self.ist, self.fst = kernels.empty_state()
         self.fst[kernels.THETA] = self.thetas[0]
         self.fst[kernels.U] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
@@ -252,8 +308,8 @@ class Realization:
     def _init_network_state(self) -> None:
         N = self.scene.network.n_nodes
         g = self.scene.ops["g"]
-        # a = F - theta g with u = 0: every spring at rest at theta(0).
-        self.a = -g * self.thetas[0]
+        # a = F - theta g with u = 0: every spring at rest at theta(0), plus the external load.
+        self.a = -g * self.thetas[0] + self._f_ext()
         self.u = np.zeros_like(g)
         self.hp = np.zeros((3, N), np.int64)
         self.hpos = np.full((N, 3), -1, np.int64)
@@ -274,8 +330,13 @@ class Realization:
             kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hv,
                                    self.hpos, self.ist, self.fst)
 
+    def _f_ext(self) -> np.ndarray:
+        """The external forces in the shape of ``a``: (N,) in 1D, (N, 2) in 2D."""
+        f_ext = self.scene.network.f_ext
+        return f_ext[:, 0].copy() if self.scene.network.dim == 1 else f_ext.copy()
+
     def recompute_forces(self) -> float:
-        """Recompute a = -K u - g theta(0) from the displacements (sparse mat-vec).
+        """Recompute a = -K u - g theta(0) + f_ext from the displacements (sparse mat-vec).
 
         Incremental updates of ``a`` accumulate rounding; this resets it and
         rebuilds the heaps. Returns the largest change of a force, in N (the
@@ -283,6 +344,7 @@ class Realization:
         """
         g = self.scene.ops["g"]
         fresh = (-(self.scene.K @ self.u.reshape(-1)) - g.reshape(-1) * self.thetas[0]).reshape(g.shape)
+        fresh += self._f_ext()
         drift = float(np.abs(fresh - self.a).max())
         self.a[...] = fresh
         self.ist[kernels.SINCE_RECOMPUTE] = 0
@@ -358,11 +420,87 @@ class Realization:
         )
 
     def advance(self, to_step: int | None = None) -> Realization:
-        """Run the thermal steps up to ``to_step`` (default: the last one)."""
+        """Run the thermal steps up to ``to_step`` (default: the last one).
+
+        With ``mu_eff_at = "records"`` the network tilt test is made on the
+        state at every recorded time passed on the way.
+        """
         sc = self.scene
         to_step = sc.steps if to_step is None else int(to_step)
         if not self.step <= to_step <= sc.steps:
             raise ValueError(f"to_step must lie in [{self.step}, {sc.steps}]; got {to_step}")
+        if sc.tilt_at == "records":
+            while self._tilted < sc.rec_times.size and sc.rec_times[self._tilted] <= to_step:
+                self._run_kernel(int(sc.rec_times[self._tilted]))
+                self._tilt_record(self._tilted)
+                self._tilted += 1
+        return self._run_kernel(to_step)
+
+    def tilt_test(self) -> float:
+        """One network tilt test on a copy of the current state: mu_eff, the load at which it slides.
+
+        Raises the uniform tangential force f N_i along +x on every node until
+        the whole network slides (see :mod:`slidernet.kernels.tilt_net` for the
+        rule, which is the appendix's for a 1D pair) and returns the total
+        tangential load per unit normal load at that moment, f plus the mean
+        f_ext along x. The state is left as it was; the draws come from the
+        realization's tilt stream.
+        """
+        from slidernet.kernels.tilt_net import N_POS, N_SLIPS, P_MU, P_U, TILT_NEED_DRAWS, tilt_test_network
+
+        sc = self.scene
+        o = sc.tilt_ops()
+        N = sc.network.n_nodes
+        if self._tilt_work is None:
+            self._tilt_work = (np.zeros((2, N), np.int64), np.zeros((2, N)), np.zeros((N, 2), np.int64),
+                               np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
+        hp, hv, hpos, epoch, pos = self._tilt_work
+        F = self.forces().reshape(N, -1)
+        while True:
+            G = np.zeros((N, 2))
+            G[:, : F.shape[1]] = F
+            pos[P_MU], pos[P_U] = self.ist[kernels.TMU_POS], self.ist[kernels.TU_POS]
+            f = tilt_test_network(G, self.mu.copy(), sc.network.normal_load, o["f_ext"], o["f_bar"], o["indptr"],
+                                  o["indices"], o["kblk"], o["diagpos"], sc.mu_d, sc.slip_mode,
+                                  o["pair_rule"], self.tmu, self.tu, pos, sc.max_avalanche,
+                                  tilt_avalanche_cap(N), hp, hv, hpos, epoch)
+            if f >= 0.0:
+                self.ist[kernels.TMU_POS], self.ist[kernels.TU_POS] = pos[P_MU], pos[P_U]
+                return float(f)
+            if f != TILT_NEED_DRAWS:
+                raise TiltTestError(
+                    f"The network tilt test did not reach sliding at step {self.step}: it made "
+                    f"{int(pos[N_SLIPS])} slips (at most solver.max_avalanche = {sc.max_avalanche} in all, "
+                    f"{tilt_avalanche_cap(N)} in one avalanche) with the load per unit normal load still "
+                    f"at or below mu_d."
+                )
+            self._refill_tilt()
+
+    def _refill_tilt(self) -> None:
+        """Top up the tilt stream's buffers after a test ran out of one of them.
+
+        A buffer with fewer than ``batch`` unread draws gets a batch
+        (thresholds first). If both still held a batch, one test needed more
+        than that (a long avalanche): both grow, so that the retry gets further.
+        """
+        sc, ist = self.scene, self.ist
+        rng = self.rngs["tilt"]
+        unread = min(self.tmu.size - ist[kernels.TMU_POS], self.tu.size - ist[kernels.TU_POS])
+        # Doubling when both held a batch keeps the retries logarithmic in the test's length.
+        batch = sc.batch if unread < sc.batch else 2 * max(self.tmu.size, self.tu.size)
+        self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], lambda size: sc.distribution.sample(rng, size), batch)
+        self.tu = _refill(self.tu, ist[kernels.TU_POS], rng.random, batch)
+        ist[kernels.TMU_POS] = 0
+        ist[kernels.TU_POS] = 0
+
+    def _tilt_record(self, k: int) -> None:
+        f = self.tilt_test()
+        self.out["f_sum"][k] += f
+        self.out["f_sq"][k] += f * f
+        self.out["f_count"][k] += 1
+
+    def _run_kernel(self, to_step: int) -> Realization:
+        sc = self.scene
         # The kernel stops at the end of the array it is given.
         thetas = self.thetas[: to_step + 1]
         dist = sc.distribution
@@ -370,9 +508,6 @@ class Realization:
 
         def draw_mu(size: int) -> np.ndarray:
             return dist.sample(self.rngs["thresholds"], size)
-
-        def draw_tmu(size: int) -> np.ndarray:
-            return dist.sample(self.rngs["tilt"], size)
 
         while True:
             status = self._call_kernel(thetas)
@@ -382,10 +517,7 @@ class Realization:
                 self.mu_buf = _refill(self.mu_buf, ist[kernels.MU_POS], draw_mu, sc.batch)
                 ist[kernels.MU_POS] = 0
             elif status == kernels.NEED_TILT:
-                self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], draw_tmu, sc.batch)
-                self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt"].random, sc.batch)
-                ist[kernels.TMU_POS] = 0
-                ist[kernels.TU_POS] = 0
+                self._refill_tilt()
             elif status == kernels.RECOMPUTE:
                 self.recompute_forces()
             elif status == kernels.AVALANCHE_LIMIT:

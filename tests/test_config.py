@@ -109,14 +109,15 @@ def test_missing_sections_are_all_reported_at_once():
         assert f"The '{section}' field is required." in msg
 
 
-def test_mu_eff_needs_two_sliders():
+def test_mu_eff_on_a_larger_network_uses_the_network_tilt_test():
+    # The appendix's test before every rearrangement is for a pair; any other
+    # network gets the network tilt test at the recorded times.
     cfg = make_config(network={"kind": "chain", "n": 5, "Ntilde": 1e-7})
     assert "mu_eff" in cfg["observables"]
-    with pytest.raises(ConfigError, match=r"'mu_eff' observable .* 2 sliders; this network has 5"):
+    assert load_config(cfg).mu_eff_at == "auto"
+    cfg["mu_eff_at"] = "rearrangements"
+    with pytest.raises(ConfigError, match=r"'mu_eff_at = \"rearrangements\"' .* needs a 1D pair of sliders"):
         load_config(cfg)
-    # Without mu_eff the same chain is fine.
-    cfg["observables"] = ["n", "mu_max", "x_G"]
-    assert load_config(cfg).network.size() == 5
 
 
 def test_pair_kernel_needs_two_sliders():

@@ -99,14 +99,20 @@ def run_csr(
     """
     steps = thetas.size - 1
     if ist[STARTED] == 0:
-        if do_tilt:
-            F = a[1] + g[1] * fst[THETA]
-            st = tilt_sample(F, mu[0], mu[1], mu_d, tmu, tu, ist, ist[REC], fsum, fsq, fcount)
-            if st != DONE:
-                return st
-        if rec_times[ist[REC]] == 0:
-            write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
-        ist[STARTED] = 1
+        if ist[HEAP_SIZE] > 0:
+            # A load f_ext above some threshold: relaxed first, as part of t = 0.
+            # No driving slip here: the avalanche's size is its slips alone.
+            ist[IN_AVALANCHE] = 1
+            ist[AV_SLIPS] = -1
+        else:
+            if do_tilt:
+                F = a[1] + g[1] * fst[THETA]
+                st = tilt_sample(F, mu[0], mu[1], mu_d, tmu, tu, ist, ist[REC], fsum, fsq, fcount)
+                if st != DONE:
+                    return st
+            if rec_times[ist[REC]] == 0:
+                write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+            ist[STARTED] = 1
     while True:
         while ist[HEAP_SIZE] > 0:
             i = hp[0, 0]
@@ -130,6 +136,12 @@ def run_csr(
             _slip(i, Fi, abs(Fi), a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
                   ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips)
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
+        if ist[STARTED] == 0:
+            # The end of the initial relaxation (the tilt test before each
+            # rearrangement needs f_ext = 0, so it never starts here).
+            if rec_times[ist[REC]] == 0:
+                write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+            ist[STARTED] = 1
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
         q = ist[Q]

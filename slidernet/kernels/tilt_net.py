@@ -1,0 +1,261 @@
+"""The virtual tilt test of a whole network (MODEL.md section 1, generalized to N sliders).
+
+On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
+= f) is added to every node and f is raised quasi-statically:
+
+1. f rises to the smallest critical value at which some node reaches its
+   threshold, |G_i + f N_i x| = mu_s,i N_i, with G_i the node's force before
+   the tilt (springs, dilation and f_ext). Keys come from a min-heap, so the
+   next critical f costs O(log N).
+2. At fixed f, that node slips by the network's slip rule and the avalanche it
+   triggers is relaxed, largest overload first (ties to the lowest index),
+   exactly as on the horizontal substrate; each slip redraws the node's
+   threshold from the tilt stream.
+3. **The whole network is set in motion** when, during one avalanche, every
+   node has slipped or is unstable. This is checked after each slip has moved
+   force to its neighbours and before its threshold is redrawn: for two
+   sliders it is eq. `stab` (the other slider moves too).
+
+   * If the total tangential load exceeds the total dynamic friction,
+     f + f_bar > mu_d with f_bar = sum_i f_ext,i,x / sum_i N_i, the motion
+     accelerates: the network slides, and the load per unit normal load at
+     that moment, f + f_bar, is the sample of mu_eff (f itself, tan(alpha_c),
+     when there is no f_ext).
+   * Otherwise the collective motion is damped (creep). For a 1D pair the
+     appendix's rule is used: both thresholds are redrawn and the spring force
+     is drawn uniformly between the two values that keep both sliders stable
+     under f. For N > 2 (or in 2D) that stable set is a polytope with no
+     natural uniform measure, so the damped motion is resolved by the slip
+     rule itself: the avalanche goes on and the count of moving nodes starts
+     again.
+
+4. **A part of the network slides on its own** when one avalanche at fixed f
+   exceeds ``av_cap`` slips without having set every node in motion. In a
+   rigid connected network a subset cannot slide for ever (the springs to the
+   rest stretch), so this happens along floppy modes: each row of a
+   ``square`` lattice (central springs only) slides along x independently.
+   If f + f_bar > mu_d that is sliding, and f + f_bar is the sample; if not,
+   the test gives up (``TILT_TOO_LONG``).
+
+For a 1D pair without ``f_ext`` this performs the appendix's test: the same
+sequence of critical forces, the same draws in the same order, and so the
+same mu_eff (tested against :func:`slidernet.kernels.tilt.tilt_test_pair`).
+One case differs, outside the paper's parameters: the appendix never lets a
+slider slip backwards, while here a slider whose threshold drops below
+mu_s,old - 2 mu_d after its slip does (it is unstable).
+
+Work arrays are the caller's: ``hp`` (2, N) int64, ``hv`` (2, N) float64,
+``hpos`` (N, 2) int64 and ``epoch`` (N,) int64, so that a test allocates
+nothing.
+"""
+
+from __future__ import annotations
+
+import math
+
+from slidernet.kernels.heap import heap_set
+from slidernet.kernels.state import kernel_jit
+from slidernet.kernels.vec import SLIP_EXACT, exact_slip
+
+# Return codes (negative: no sample).
+TILT_NEED_DRAWS = -1.0
+TILT_TOO_LONG = -2.0
+
+# Slots of the small integer array ``pos`` (shape (N_POS,)) shared with the caller.
+P_MU = 0  # read position in the threshold buffer
+P_U = 1  # read position in the uniform buffer
+_UNSTABLE = 2  # size slot of heap 0 (overload)
+_CRITICAL = 3  # size slot of heap 1 (critical f)
+N_SLIPS = 4  # slips made by the test (out)
+N_POS = 5
+
+
+@kernel_jit(inline="always")
+def _critical_f(Gx, Gy, lim, n):
+    """The f >= current at which |(Gx + f n, Gy)| reaches lim (the upper root)."""
+    if Gy == 0.0:
+        return (lim - Gx) / n
+    r = lim * lim - Gy * Gy
+    return (-Gx + math.sqrt(max(r, 0.0))) / n
+
+
+@kernel_jit(inline="always")
+def _key(j, f, G, mu, normal_load, hp, hv, hpos, sz):
+    """Re-key node j in both heaps at tilt f; returns True if it is unstable."""
+    n = normal_load[j]
+    lim = mu[j] * n
+    Tx = G[j, 0] + f * n
+    Ty = G[j, 1]
+    T = math.sqrt(Tx * Tx + Ty * Ty)
+    unstable = T > lim
+    heap_set(j, T / lim, unstable, hp, hv, hpos, 0, sz, _UNSTABLE)
+    heap_set(j, -_critical_f(G[j, 0], G[j, 1], lim, n), True, hp, hv, hpos, 1, sz, _CRITICAL)
+    return unstable
+
+
+@kernel_jit()
+def tilt_test_network(G, mu, normal_load, f_ext, f_bar, indptr, indices, kblk, diagpos, mu_d, slip_mode,
+                      pair_rule, tmu, tu, pos, max_slips, av_cap, hp, hv, hpos, epoch):
+    """Raise a uniform tilt on a copy of a network until it slides as a whole.
+
+    Parameters
+    ----------
+    G : ndarray, shape (N, 2)
+        Forces on the nodes before the tilt, in units of N (overwritten: pass a
+        copy). 1D networks pass their forces in column 0 and zeros in column 1.
+    mu : ndarray, shape (N,)
+        Thresholds mu_s (overwritten: pass a copy).
+    normal_load : ndarray, shape (N,)
+        N_i in units of N; the tilt force on node i is f N_i along +x.
+    f_ext : ndarray, shape (N, 2)
+        The constant external forces included in G (used by the pair rule).
+    f_bar : float
+        sum_i f_ext,i,x / sum_i N_i: the external load per unit normal load along x.
+    indptr, indices, kblk, diagpos
+        Block-CSR rows of K, blocks (nnzb, 2, 2), and the slot of each K_ii.
+    mu_d : float
+        Dynamic coefficient.
+    slip_mode : int
+        0: straight-line slip; 1: exactly integrated 2D slip.
+    pair_rule : bool
+        Use the appendix's creep rule (a 1D pair of sliders).
+    tmu, tu : ndarray
+        Thresholds and uniforms of the tilt stream, read from ``pos[P_MU]``
+        and ``pos[P_U]``; the positions advance only if a sample is returned.
+    pos : ndarray of int64, shape (N_POS,)
+        Read positions (slots ``P_MU``, ``P_U``) and the slip count (``N_SLIPS``).
+    max_slips : int
+        Give up after this many slips.
+    av_cap : int
+        Slips of one avalanche after which a part of the network is taken to
+        slide on its own (rule 4).
+
+    Returns
+    -------
+    float
+        f + f_bar when the network slides (a mu_eff sample), ``TILT_NEED_DRAWS``
+        if a buffer ran out, ``TILT_TOO_LONG`` after ``max_slips`` slips.
+    """
+    N = mu.size
+    p_mu = pos[P_MU]
+    p_u = pos[P_U]
+    sz = pos  # heap sizes live in slots _UNSTABLE and _CRITICAL
+    sz[_UNSTABLE] = 0
+    sz[_CRITICAL] = 0
+    hpos[:] = -1
+    f = 0.0
+    for j in range(N):
+        _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
+        epoch[j] = -1
+    ep = 0
+    slips = 0
+    # moved: nodes that slipped in the current avalanche; pending: unstable nodes that have not.
+    moved = 0
+    pending = sz[_UNSTABLE]
+    driving = True
+    av_slips = 0
+    while True:
+        if sz[_UNSTABLE] == 0:
+            # Raise f to the next critical value; a new avalanche starts.
+            fc = -hv[1, 0]
+            if fc > f:
+                f = fc
+            i = hp[1, 0]
+            ep += 1
+            moved = 0
+            pending = 0
+            driving = True
+            av_slips = 0
+        else:
+            i = hp[0, 0]
+            driving = False
+        slips += 1
+        av_slips += 1
+        if slips > max_slips:
+            pos[N_SLIPS] = slips
+            return TILT_TOO_LONG
+        if av_slips > av_cap:
+            pos[N_SLIPS] = slips
+            if f + f_bar > mu_d:
+                pos[P_MU] = p_mu
+                pos[P_U] = p_u
+                return f + f_bar
+            return TILT_TOO_LONG
+        n = normal_load[i]
+        lim = mu[i] * n
+        Tx = G[i, 0] + f * n
+        Ty = G[i, 1]
+        # A driving slip starts exactly at the threshold, as on the horizontal substrate.
+        T = lim if driving else math.sqrt(Tx * Tx + Ty * Ty)
+        if epoch[i] != ep:
+            if hpos[i, 0] >= 0:
+                pending -= 1
+            epoch[i] = ep
+            moved += 1
+        fd = mu_d * n
+        d = diagpos[i]
+        kxx = kblk[d, 0, 0]
+        kxy = kblk[d, 0, 1]
+        kyy = kblk[d, 1, 1]
+        if slip_mode == SLIP_EXACT:
+            dux, duy, nsteps = exact_slip(Tx, Ty, kxx, kxy, kyy, fd)
+            if nsteps < 0:
+                pos[N_SLIPS] = slips
+                return TILT_TOO_LONG
+        else:
+            Tn = math.sqrt(Tx * Tx + Ty * Ty)
+            ex = Tx / Tn
+            ey = Ty / Tn
+            keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
+            length = 2.0 * (T - fd) / keff
+            dux = length * ex
+            duy = length * ey
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            G[j, 0] -= kblk[p, 0, 0] * dux + kblk[p, 0, 1] * duy
+            G[j, 1] -= kblk[p, 1, 0] * dux + kblk[p, 1, 1] * duy
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if j == i:
+                continue
+            was = hpos[j, 0] >= 0
+            now = _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
+            if epoch[j] != ep:
+                pending += int(now) - int(was)
+        if moved + pending == N:
+            # Every node is in motion at once.
+            if f + f_bar > mu_d:
+                pos[P_MU] = p_mu
+                pos[P_U] = p_u
+                pos[N_SLIPS] = slips
+                return f + f_bar
+            if pair_rule:
+                if p_mu + 2 > tmu.size or p_u + 1 > tu.size:
+                    return TILT_NEED_DRAWS
+                mu[0] = tmu[p_mu]
+                mu[1] = tmu[p_mu + 1]
+                p_mu += 2
+                # The appendix: the spring force F on slider 2 uniform between
+                # the values that keep both sliders stable under f.
+                lo = f * normal_load[0] + f_ext[0, 0] - mu[0] * normal_load[0]
+                hi = mu[1] * normal_load[1] - f * normal_load[1] - f_ext[1, 0]
+                F = lo + (hi - lo) * tu[p_u]
+                p_u += 1
+                G[0, 0] = f_ext[0, 0] - F
+                G[1, 0] = f_ext[1, 0] + F
+                # Both sliders are at rest: the next event is a critical f.
+                for j in range(2):
+                    _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
+                    heap_set(j, 0.0, False, hp, hv, hpos, 0, sz, _UNSTABLE)
+                continue
+            # Damped collective motion: the avalanche goes on, counted afresh
+            # from the node that is moving now.
+            ep += 1
+            epoch[i] = ep
+            moved = 1
+            pending = sz[_UNSTABLE] - (1 if hpos[i, 0] >= 0 else 0)
+        if p_mu + 1 > tmu.size:
+            return TILT_NEED_DRAWS
+        mu[i] = tmu[p_mu]
+        p_mu += 1
+        _key(i, f, G, mu, normal_load, hp, hv, hpos, sz)

@@ -1,0 +1,221 @@
+"""A constant external force f_ext (creep) and the network tilt test (MODEL.md section 2)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import slidernet
+from slidernet import kernels
+from slidernet.builders import triangular
+from slidernet.config import load_config
+from slidernet.distributions import Gaussian, TruncatedBelow
+from slidernet.errors import ConfigError
+from slidernet.kernels.tilt_net import N_POS, P_MU, P_U, tilt_test_network
+from slidernet.network import Network, chain
+from slidernet.solver import Realization, Scene
+
+from .conftest import make_config
+
+NET_OBS = ["n", "mu_max", "x_G"]
+
+
+def chain_config(n: int = 2, sigma_ratio: float = 3.0, **changes) -> dict:
+    return make_config(**{"steps": 30, "record": "all", "observables": NET_OBS,
+                          "network": {"kind": "chain", "n": n, "Ntilde": 1e-7},
+                          "driver.sigma_theta": sigma_ratio * 1e-7, **changes})
+
+
+# --- the network tilt test reduces to the appendix's for two sliders -------
+
+
+def _pair_work(N: int = 2):
+    return (np.zeros((2, N), np.int64), np.zeros((2, N)), np.zeros((N, 2), np.int64),
+            np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
+
+
+def network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu):
+    """tilt_test_network on a 2-node chain with spring force F on slider 2 (in N)."""
+    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_ops()
+    G = np.array([[-F, 0.0], [F, 0.0]])
+    hp, hv, hpos, epoch, pos = _pair_work()
+    f = tilt_test_network(G, np.array([mu1, mu2]), np.ones(2), ops["f_ext"], ops["f_bar"], ops["indptr"],
+                          ops["indices"], ops["kblk"], ops["diagpos"], mu_d, 0, ops["pair_rule"],
+                          np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, 10_000, hp, hv, hpos,
+                          epoch)
+    return f, int(pos[P_MU]), int(pos[P_U])
+
+
+def pair_tilt(F, mu1, mu2, mu_d, tmu, tu):
+    ist, _ = kernels.empty_state()
+    f = kernels.tilt_test_pair(F, mu1, mu2, mu_d, np.asarray(tmu, float), np.asarray(tu, float), ist)
+    return f, int(ist[kernels.TMU_POS]), int(ist[kernels.TU_POS])
+
+
+@pytest.mark.parametrize(
+    ("F", "mu1", "mu2", "tmu", "tu"),
+    [(0.0, 0.6, 0.7, [], []), (0.0, 0.6, 0.9, [0.7, 9.9], []), (-0.35, 0.8, 0.6, [0.7, 0.65, 9.9], [0.25, 0.9]),
+     (0.0, 0.9, 0.6, [0.7], [])],
+    ids=["immediate", "single", "creep", "slider2"],
+)
+def test_network_tilt_equals_the_appendix_on_worked_cases(F, mu1, mu2, tmu, tu):
+    # The worked cases of test_kernels.py, through the general N-node test.
+    assert network_tilt_on_pair(F, mu1, mu2, 0.5, tmu, tu) == pytest.approx(pair_tilt(F, mu1, mu2, 0.5, tmu, tu),
+                                                                            abs=1e-15)
+
+
+def test_network_tilt_equals_the_appendix_on_random_states():
+    # 2000 random stable pairs, all three branches of the appendix; seed 7.
+    # Thresholds stay below 3 mu_d, where the appendix's slider never slips
+    # backwards (the one case where the two rules part, documented in tilt_net).
+    rng = np.random.default_rng(7)
+    branches = {"creep": 0, "single": 0, "immediate": 0}
+    for _ in range(2000):
+        mu_d = rng.uniform(0.2, 0.6)
+        dist = TruncatedBelow(Gaussian(mu_d + rng.uniform(0.02, 0.3), rng.uniform(0.01, 0.2)), mu_d, "g")
+        draws = dist.sample(rng, 1000)
+        draws = draws[draws < 3 * mu_d]
+        mu1, mu2, tmu = draws[0], draws[1], draws[2:]
+        F = rng.uniform(-1, 1) * min(mu1, mu2)
+        tu = rng.random(200)
+        ref = pair_tilt(F, mu1, mu2, mu_d, tmu, tu)
+        got = network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu)
+        assert got[0] == pytest.approx(ref[0], rel=1e-12, abs=1e-12), (F, mu1, mu2, mu_d)
+        assert got[1:] == ref[1:]
+        branches["creep" if ref[2] else ("single" if ref[1] else "immediate")] += 1
+    assert min(branches.values()) >= 50, branches
+
+
+def test_network_tilt_out_of_draws_asks_for_more_and_rolls_back():
+    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_ops()
+    hp, hv, hpos, epoch, pos = _pair_work()
+    pos[P_MU], pos[P_U] = 3, 1
+    f = tilt_test_network(np.zeros((2, 2)), np.array([0.6, 0.9]), np.ones(2), ops["f_ext"], 0.0, ops["indptr"],
+                          ops["indices"], ops["kblk"], ops["diagpos"], 0.5, 0, True, np.full(3, 0.7),
+                          np.full(1, 0.5), pos, 100, 100, hp, hv, hpos, epoch)
+    assert f == -1.0
+    assert (pos[P_MU], pos[P_U]) == (3, 1)
+
+
+# --- mu_eff at the recorded times for any network --------------------------
+
+
+def test_mu_eff_on_a_lattice_at_every_recorded_time():
+    cfg = make_config(**{"seed": 4, "realizations": 2, "steps": 20, "record": [5, 10],
+                         "observables": [*NET_OBS, "mu_eff"],
+                         "network": {"kind": "triangular", "shape": [4, 5], "Ntilde": 1e-7},
+                         "driver.sigma_theta": 3e-7})
+    ds = slidernet.run(cfg, progress=False)
+    assert ds.attrs["kernel"] == "vec"
+    # One test per realization at t = 0, 5, 10 and 20.
+    np.testing.assert_array_equal(ds["mu_eff_count"].values, [2, 2, 2, 2])
+    # A whole network slides under a load between mu_d and the largest threshold.
+    assert (ds["mu_eff"].values > 0.5).all()
+    assert (ds["mu_eff"].values <= ds["mu_max"].max().item()).all()
+
+
+def test_the_tilt_test_changes_nothing_but_the_tilt_stream():
+    base = make_config(**{"steps": 25, "record": "all", "observables": NET_OBS,
+                          "network": {"kind": "square", "shape": [4, 4], "Ntilde": 1e-7},
+                          "driver.sigma_theta": 3e-7})
+    tilted = {**base, "observables": [*NET_OBS, "mu_eff"], "mu_eff_at": "records"}
+    a = Realization(Scene.from_config(load_config(base)), np.random.SeedSequence(9)).advance().result()
+    b = Realization(Scene.from_config(load_config(tilted)), np.random.SeedSequence(9)).advance().result()
+    for name in ("n", "mu_max", "x_G", "y_G", "node_slips"):
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+    assert b["f_count"].sum() == 26
+
+
+def test_a_tilt_test_leaves_the_state_as_it_was():
+    cfg = load_config(chain_config(6, observables=[*NET_OBS, "mu_eff"]))
+    r = Realization(Scene.from_config(cfg), np.random.SeedSequence(1)).advance(10)
+    F, mu, u = r.forces().copy(), r.thresholds, r.displacements()
+    f = r.tilt_test()
+    assert f > cfg.friction.mu_d
+    np.testing.assert_array_equal(r.forces(), F)
+    np.testing.assert_array_equal(r.thresholds, mu)
+    np.testing.assert_array_equal(r.displacements(), u)
+
+
+def test_mu_eff_before_every_rearrangement_needs_a_pair():
+    cfg = chain_config(5, observables=[*NET_OBS, "mu_eff"], mu_eff_at="rearrangements")
+    with pytest.raises(ConfigError, match=r"needs a 1D pair of sliders .* use 'records'"):
+        load_config(cfg)
+
+
+def test_a_two_slider_pair_gets_the_appendix_test_by_default():
+    scene = Scene.from_config(load_config(make_config(steps=10)))
+    assert scene.tilt_at == "rearrangements"
+    chain5 = Scene.from_config(load_config(chain_config(5, observables=[*NET_OBS, "mu_eff"])))
+    assert chain5.tilt_at == "records"
+
+
+# --- f_ext: validation ---------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("value", "match"),
+    [(np.nan, "must be finite"), ([[1.0, 2.0, 3.0]], r"shape \(1, 3\)"), (np.ones(5), r"shape \(5,\)")],
+    ids=["nan", "three-components", "wrong-length"],
+)
+def test_bad_f_ext_is_refused(value, match):
+    net = triangular((2, 2), Ntilde=1e-7)
+    with pytest.raises(ConfigError, match=rf"'f_ext' parameter of Network .*{match}"):
+        Network(net.positions, net.edges, Ntilde=1e-7, f_ext=value)
+
+
+def test_a_vector_f_ext_on_a_chain_is_refused():
+    with pytest.raises(ConfigError, match=r"network is 1D: 'f_ext' must be a number"):
+        load_config(chain_config(4, **{"network.f_ext": [0.1, 0.2]}))
+
+
+@pytest.mark.parametrize(("value", "expected"), [(0.2, [0.2, 0.0]), ([0.1, -0.3], [0.1, -0.3])],
+                         ids=["number", "vector"])
+def test_f_ext_shapes(value, expected):
+    net = triangular((2, 3), Ntilde=1e-7)
+    net2 = Network(net.positions, net.edges, Ntilde=1e-7, f_ext=value)
+    np.testing.assert_array_equal(net2.f_ext, np.tile(expected, (6, 1)))
+
+
+def test_f_ext_survives_a_graphml_round_trip(tmp_path):
+    from slidernet.builders import from_graph, read_graph, write_graph
+
+    net = triangular((3, 3), Ntilde=1e-7, f_ext=[0.05, -0.01])
+    (path,) = write_graph(net, tmp_path / "net.graphml")
+    back = from_graph(read_graph(path), Ntilde=1e-7)
+    np.testing.assert_allclose(back.f_ext, net.f_ext)
+
+
+# --- f_ext: mechanics ----------------------------------------------------
+
+
+def test_an_f_ext_above_the_thresholds_is_relaxed_at_t0():
+    # f_ext = 0.55 N on each slider of a chain: sliders whose mu_s < 0.55 slip
+    # at once; the initial record shows a stable state with those slips.
+    cfg = chain_config(8, **{"network.f_ext": 0.55, "friction.static.std": 0.05})
+    r = Realization(Scene.from_config(load_config(cfg)), np.random.SeedSequence(3))
+    weak = int((r.thresholds < 0.55).sum())
+    assert weak > 0
+    r.advance(0)
+    assert r.n >= weak
+    res = r.result()
+    assert res["n"][0] == r.n
+    assert (np.abs(r.forces()) <= r.thresholds * (1 + 1e-12)).all()
+    # The external load is carried by the substrate: the net force is N f_ext.
+    assert r.forces().sum() == pytest.approx(8 * 0.55, rel=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["chain", "triangular"])
+def test_thermal_cycling_makes_the_network_creep_downhill(kind):
+    # Same seed, f_ext = 0 against f_ext = 0.05 N along +x; 200 tau_th; seed 12.
+    net = {"kind": "chain", "n": 6} if kind == "chain" else {"kind": "triangular", "shape": [4, 4]}
+
+    def drift(f_ext: float) -> float:
+        cfg = make_config(**{"seed": 12, "realizations": 4, "steps": 200, "record": [0],
+                             "observables": NET_OBS, "network": {**net, "Ntilde": 1e-7, "f_ext": f_ext},
+                             "driver.sigma_theta": 3e-7})
+        return float(slidernet.run(cfg, progress=False)["x_G_mean"].isel(t=-1))
+
+    # Without load x_G wanders by ~ sigma_theta; with it, it creeps by many times that.
+    assert drift(0.05) > 20 * 3e-7
+    assert abs(drift(0.0)) < 5 * 3e-7
