@@ -43,7 +43,7 @@ else:  # pragma: no cover
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records")
+OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records", "events")
 
 
 class _Strict(BaseModel):
@@ -146,6 +146,9 @@ class SolverConfig(_Strict):
     forces from the displacements by a sparse mat-vec, against drift.
     ``slip`` chooses, in 2D, between the straight-line slip along the force
     (exact where K_ii is isotropic) and the exactly integrated 2D slip.
+    ``max_events`` caps the event catalogue (observable ``events``) of one
+    realization: past it the catalogue stops, with a warning, and the result
+    says it is incomplete; the run itself goes on.
     """
 
     kernel: Literal["auto", "pair", "csr", "vec"] = "auto"
@@ -153,6 +156,7 @@ class SolverConfig(_Strict):
     batch: Annotated[int, Field(ge=16)] = 1 << 16
     recompute_every: Annotated[int, Field(ge=0)] = 10_000_000
     slip: Literal["straight", "exact"] = "straight"
+    max_events: Annotated[int, Field(ge=1)] = 10_000_000
 
 
 class Config(_Strict):
@@ -170,7 +174,7 @@ class Config(_Strict):
     steps: Annotated[int, Field(ge=1)]
     record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = "log"
     log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = 20
-    observables: list[Literal["n", "mu_max", "x_G", "mu_eff", "n_records"]] = Field(
+    observables: list[Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events"]] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"]
     )
     mu_eff_at: Literal["auto", "rearrangements", "records"] = "auto"
@@ -196,6 +200,9 @@ class Config(_Strict):
             )
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
+        if self.solver.kernel == "pair" and "events" in self.observables:
+            raise ValueError("the 'events' observable (the event catalogue) needs a network kernel; "
+                             "use 'solver.kernel = \"auto\"' or '\"csr\"'")
         return self
 
     def distribution(self) -> TruncatedBelow:

@@ -60,6 +60,34 @@ def _network_variables(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> 
                             {"long_name": "number of slips of each node", "units": "1"})
         ds["mu_s"] = (("realization", "node"), np.stack([r["mu_s"] for r in records]),
                       {"long_name": "static threshold of each node at the end", "units": "1"})
+    if "events" in first:
+        _event_catalogue(ds, records)
+
+
+EVENT_ATTRS = {
+    "time": ("time of the slip (q + fraction of the thermal step at its driving event)", "tau_th"),
+    "node": ("node that slipped", "1"),
+    "avalanche": ("avalanche id: driving events so far in the realization (0: initial relaxation)", "1"),
+    "dx": ("displacement of the node along x", "l0"),
+    "dy": ("displacement of the node along y", "l0"),
+}
+
+
+def _event_catalogue(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> None:
+    """The slips of every realization, one after the other, along dim ``event``."""
+    events = [r["events"] for r in records]
+    sizes = [e["node"].size for e in events]
+    ds["event_realization"] = ("event", np.repeat(np.arange(len(records)), sizes),
+                               {"long_name": "realization of the slip", "units": "1"})
+    two_d = "y_G" in ds
+    for name, (long_name, units) in EVENT_ATTRS.items():
+        if name == "dy" and not two_d:
+            continue
+        ds[f"event_{name}"] = ("event", np.concatenate([e[name] for e in events]),
+                               {"long_name": long_name, "units": units})
+    ds["events_complete"] = ("realization", np.array([int(r["events_complete"]) for r in records], np.int8),
+                             {"long_name": "1 if every slip is in the catalogue (solver.max_events not reached)",
+                              "units": "1"})
 
 
 def assemble(

@@ -13,6 +13,7 @@ one rearrangement to the next by solving eq. `critique` exactly.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -43,6 +44,9 @@ def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> n
     else:
         t = np.asarray(record, dtype=np.int64)
     return np.unique(np.concatenate([[0, steps], t])).astype(np.int64)
+
+
+EVENT_CHUNK = 1 << 16  # rows of the event-catalogue buffer the kernel fills between returns
 
 
 def build_network(cfg: Config) -> Network:
@@ -127,6 +131,8 @@ class Scene:
     batch: int
     recompute_every: int
     slip_mode: int
+    catalogue: bool = False
+    max_events: int = 0
     ops: dict[str, np.ndarray] = field(default_factory=dict)
     K: Any = None
     _tilt_ops: dict[str, Any] | None = field(default=None, repr=False)
@@ -148,8 +154,10 @@ class Scene:
         net = build_network(cfg) if network is None else network
         family, K, ops = _operators(net)
         kernel = cfg.solver.kernel
+        catalogue = "events" in cfg.observables
         if kernel == "auto":
-            kernel = "pair" if net.is_two_slider() else family
+            # The pair kernel keeps scalars only: no per-node event catalogue.
+            kernel = "pair" if net.is_two_slider() and not catalogue else family
         if kernel != family and not (kernel == "pair" and net.is_two_slider()):
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
@@ -178,6 +186,8 @@ class Scene:
             batch=cfg.solver.batch,
             recompute_every=cfg.solver.recompute_every,
             slip_mode=1 if cfg.solver.slip == "exact" else 0,
+            catalogue=catalogue,
+            max_events=cfg.solver.max_events,
             ops=ops,
             K=K,
         )
@@ -316,9 +326,18 @@ class Realization:
         self.hv = np.zeros((3, N))
         self.aval_hist = np.zeros(kernels.N_AVALANCHE_BINS, np.int64)
         self.node_slips = np.zeros(N, np.int64)
+        T = self.scene.rec_times.size
+        self.out.update(mu_mean=np.zeros(T), mu_min=np.zeros(T))
         if self.scene.kernel == "vec":
-            T = self.scene.rec_times.size
-            self.out.update(y_G=np.zeros(T), mu_mean=np.zeros(T), mu_min=np.zeros(T))
+            self.out.update(y_G=np.zeros(T))
+        # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows,
+        # Python keeps the full ones (at most max_events rows in all).
+        rows = EVENT_CHUNK if self.scene.catalogue else 0
+        self.ev_i = np.zeros((rows, 2), np.int64)
+        self.ev_f = np.zeros((rows, 3))
+        self._event_chunks: list[tuple[np.ndarray, np.ndarray]] = []
+        self.events_complete = True
+        self.ist[kernels.EV_ON] = int(self.scene.catalogue)
         self._rebuild_heaps()
 
     def _rebuild_heaps(self) -> None:
@@ -407,15 +426,15 @@ class Realization:
                 thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
                 self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, sc.recompute_every,
                 o["indptr"], o["indices"], o["kdata"], o["kdiag"], o["g"], o["normal_load"],
-                o["w"], self.hp, self.hv, self.hpos, self.aval_hist, self.node_slips,
-                out["n"], out["mu_max"], out["x_G"], out["n_records"], out["f_sum"],
-                out["f_sq"], out["f_count"],
+                o["w"], self.hp, self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i,
+                self.ev_f, out["n"], out["mu_max"], out["x_G"], out["n_records"], out["mu_mean"],
+                out["mu_min"], out["f_sum"], out["f_sq"], out["f_count"],
             )
         return kernels.run_vec(
             thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
             sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
             o["indices"], o["kblk"], o["diagpos"], o["g"], o["driven"], o["normal_load"], o["w"], self.hp,
-            self.hv, self.hpos, self.aval_hist, self.node_slips, out["n"], out["mu_max"],
+            self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i, self.ev_f, out["n"], out["mu_max"],
             out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
         )
 
@@ -520,6 +539,8 @@ class Realization:
                 self._refill_tilt()
             elif status == kernels.RECOMPUTE:
                 self.recompute_forces()
+            elif status == kernels.NEED_EVENTS:
+                self._flush_events()
             elif status == kernels.AVALANCHE_LIMIT:
                 i = int(ist[kernels.ERR_NODE])
                 force = np.round(np.atleast_1d(self.forces()[i]), 12).tolist()
@@ -536,6 +557,45 @@ class Realization:
                 )
             else:  # pragma: no cover - a new status code without a handler is a bug
                 raise RuntimeError(f"unknown kernel status {status}")
+
+    def _flush_events(self) -> None:
+        """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``."""
+        k = int(self.ist[kernels.EV_POS])
+        self._event_chunks.append((self.ev_i[:k].copy(), self.ev_f[:k].copy()))
+        self.ist[kernels.EV_POS] = 0
+        kept = sum(c[0].shape[0] for c in self._event_chunks)
+        room = self.scene.max_events - kept
+        if room < self.ev_i.shape[0]:
+            self.ev_i = self.ev_i[:room]
+            self.ev_f = self.ev_f[:room]
+        if room == 0:
+            self.ist[kernels.EV_ON] = 0
+            self.events_complete = False
+            warnings.warn(
+                f"The event catalogue reached solver.max_events = {self.scene.max_events} events at step "
+                f"{self.step}; later slips are not catalogued (the run goes on).",
+                RuntimeWarning, stacklevel=4,
+            )
+
+    def events(self) -> dict[str, np.ndarray]:
+        """The event catalogue so far: one row per slip, in the order of the slips.
+
+        Returns
+        -------
+        dict of str to ndarray, each of shape (S,), S the number of catalogued slips
+            ``time`` (tau_th: q plus the fraction of the thermal step at the
+            driving event), ``node`` (int64), ``avalanche`` (int64: the number
+            of driving events so far; 0 for the relaxation of an initial
+            overload at t = 0), ``dx`` and ``dy`` (the node's displacement, in
+            l0; ``dy`` is 0 in 1D).
+        """
+        k = int(self.ist[kernels.EV_POS])
+        chunks = [*self._event_chunks, (self.ev_i[:k], self.ev_f[:k])]
+        ev_i = np.concatenate([c[0] for c in chunks])
+        ev_f = np.concatenate([c[1] for c in chunks])
+        Ntilde = self.scene.network.Ntilde
+        return {"time": ev_f[:, 0].copy(), "node": ev_i[:, 0].copy(), "avalanche": ev_i[:, 1].copy(),
+                "dx": ev_f[:, 1] * Ntilde, "dy": ev_f[:, 2] * Ntilde}
 
     def result(self) -> dict[str, np.ndarray]:
         """The records at ``scene.rec_times`` (x_G converted to l0).
@@ -557,6 +617,9 @@ class Realization:
             res["avalanche_count"] = self.aval_hist.copy()
             res["node_slips"] = self.node_slips.copy()
             res["mu_s"] = self.mu.copy()
+        if self.scene.catalogue:
+            res["events"] = self.events()
+            res["events_complete"] = self.events_complete
         return res
 
 

@@ -9,17 +9,21 @@ these only change when the node or a neighbour slips.
 
 from __future__ import annotations
 
-from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
+from slidernet.kernels.heap import avalanche_done, heap_set, log_event, mu_stats, redraw_threshold
 from slidernet.kernels.state import (
     AV_SLIPS,
     AVALANCHE_LIMIT,
     DONE,
     DOWN_SIZE,
     ERR_NODE,
+    EV_ON,
+    EV_POS,
+    EV_T,
     HEAP_SIZE,
     IN_AVALANCHE,
     MU_POS,
     N_EVENTS,
+    NEED_EVENTS,
     NEED_MU,
     REC,
     RECOMPUTE,
@@ -70,10 +74,11 @@ def init_csr_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
 
 @kernel_jit()
 def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
-          ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips):
+          ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone (undamped half-oscillation); its threshold is redrawn."""
     sgn = 1.0 if Fi > 0.0 else -1.0
     du = 2.0 * (absF - mu_d * normal_load[i]) * sgn / kdiag[i]
+    log_event(i, du, 0.0, ist, fst, ev_i, ev_f)
     u[i] += du
     for p in range(indptr[i], indptr[i + 1]):
         a[indices[p]] -= kdata[p] * du
@@ -85,17 +90,27 @@ def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, 
 
 
 @kernel_jit()
+def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min):
+    k = ist[REC]
+    write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+    out_mu_mean[k], out_mu_min[k] = mu_stats(mu)
+
+
+@kernel_jit()
 def run_csr(
     thetas, rec_times, mu, ist, fst, a, u, mu_buf, tmu, tu, mu_d, do_tilt, max_slips,
     recompute_every, indptr, indices, kdata, kdiag, g, normal_load, w, hp, hv, hpos,
-    aval_hist, node_slips, out_n, out_mu_max, out_xg, out_records, fsum, fsq, fcount,
+    aval_hist, node_slips, ev_i, ev_f, out_n, out_mu_max, out_xg, out_records, out_mu_mean,
+    out_mu_min, fsum, fsq, fcount,
 ):
     """Advance a 1D network through ``thetas`` (units of Ntilde).
 
     The heaps must have been built by :func:`init_csr_heaps`. The tilt test
     (``do_tilt``) is defined for 2-node networks only. Returns ``RECOMPUTE``
     every ``recompute_every`` slips (0: never) so that the caller can
-    recompute ``a`` from ``u`` and rebuild the heaps.
+    recompute ``a`` from ``u`` and rebuild the heaps, and ``NEED_EVENTS``
+    when the event catalogue (``ev_i``, ``ev_f``, see
+    :func:`~slidernet.kernels.heap.log_event`) is on and its buffer is full.
     """
     steps = thetas.size - 1
     if ist[STARTED] == 0:
@@ -111,7 +126,7 @@ def run_csr(
                 if st != DONE:
                     return st
             if rec_times[ist[REC]] == 0:
-                write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+                _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)
             ist[STARTED] = 1
     while True:
         while ist[HEAP_SIZE] > 0:
@@ -127,6 +142,9 @@ def run_csr(
             if ist[MU_POS] >= mu_buf.size:
                 ist[AV_SLIPS] -= 1
                 return NEED_MU
+            if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
+                ist[AV_SLIPS] -= 1
+                return NEED_EVENTS
             if do_tilt:
                 st = tilt_sample(a[1] + g[1] * theta, mu[0], mu[1], mu_d, tmu, tu, ist,
                                  ist[REC], fsum, fsq, fcount)
@@ -134,13 +152,13 @@ def run_csr(
                     ist[AV_SLIPS] -= 1
                     return st
             _slip(i, Fi, abs(Fi), a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
-                  ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips)
+                  ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f)
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
         if ist[STARTED] == 0:
             # The end of the initial relaxation (the tilt test before each
             # rearrangement needs f_ext = 0, so it never starts here).
             if rec_times[ist[REC]] == 0:
-                write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+                _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)
             ist[STARTED] = 1
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
@@ -164,6 +182,8 @@ def run_csr(
                 fst[THETA] = thc
                 if ist[MU_POS] >= mu_buf.size:
                     return NEED_MU
+                if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
+                    return NEED_EVENTS
                 if do_tilt:
                     st = tilt_sample(a[1] + g[1] * thc, mu[0], mu[1], mu_d, tmu, tu, ist,
                                      ist[REC], fsum, fsq, fcount)
@@ -176,10 +196,11 @@ def run_csr(
                 ist[AV_SLIPS] = 0
                 ist[IN_AVALANCHE] = 1
                 ist[N_EVENTS] += 1
+                fst[EV_T] = q + (thc - thetas[q]) / (theta_b - thetas[q])
                 _slip(best, sigma * lim, lim, a, u, mu, indptr, indices, kdata, kdiag, g,
-                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips)
+                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f)
                 continue
         ist[Q] = q + 1
         fst[THETA] = theta_b
         if ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1:
-            write_record(ist, fst, out_n, out_mu_max, out_xg, out_records)
+            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)

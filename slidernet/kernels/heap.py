@@ -16,8 +16,11 @@ from __future__ import annotations
 
 from slidernet.kernels.state import (
     ARGMAX,
+    EV_POS,
+    EV_T,
     MU_MAX,
     MU_POS,
+    N_EVENTS,
     N_RECORDS,
     N_SLIPS,
     SINCE_RECOMPUTE,
@@ -143,3 +146,34 @@ def redraw_threshold(i, mu, mu_buf, ist, fst, node_slips):
     ist[N_SLIPS] += 1
     ist[SINCE_RECOMPUTE] += 1
     node_slips[i] += 1
+
+
+@kernel_jit(inline="always")
+def log_event(i, dux, duy, ist, fst, ev_i, ev_f):
+    """Append the slip of node i to the event catalogue, if it is recorded.
+
+    ``ev_i`` (cap, 2) int64 gets (node, avalanche id), ``ev_f`` (cap, 3)
+    float64 gets (time in tau_th, du_x, du_y in Ntilde l0). The avalanche id
+    is the number of driving events so far (0: the relaxation at t = 0).
+    The caller checks for room before the slip; with the catalogue off the
+    buffers have no rows and nothing is written.
+    """
+    k = ist[EV_POS]
+    if k < ev_i.shape[0]:
+        ev_i[k, 0] = i
+        ev_i[k, 1] = ist[N_EVENTS]
+        ev_f[k, 0] = fst[EV_T]
+        ev_f[k, 1] = dux
+        ev_f[k, 2] = duy
+        ist[EV_POS] = k + 1
+
+
+@kernel_jit()
+def mu_stats(mu):
+    """Mean and smallest threshold over the nodes, O(N): called at recorded times only."""
+    total = 0.0
+    low = mu[0]
+    for j in range(mu.size):
+        total += mu[j]
+        low = min(low, mu[j])
+    return total / mu.size, low

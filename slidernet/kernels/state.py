@@ -43,6 +43,7 @@ NEED_TILT = 2  # the tilt-test buffers ran out during a test (rolled back)
 AVALANCHE_LIMIT = 3  # an avalanche exceeded max_slips
 TILT_LIMIT = 4  # a tilt test exceeded its iteration cap
 RECOMPUTE = 5  # time to recompute the forces from the displacements (drift control)
+NEED_EVENTS = 6  # the event catalogue's buffer is full
 
 # Integer state (ist) slots.
 Q = 0  # next thermal step: the segment thetas[q] -> thetas[q+1]
@@ -62,7 +63,9 @@ UP_SIZE = 13  # size of the heap of upper critical thetas (driving with theta in
 DOWN_SIZE = 14  # size of the heap of lower critical thetas (theta decreasing)
 SINCE_RECOMPUTE = 15  # slips since the forces were last recomputed from u
 IN_AVALANCHE = 16  # 1 between a driving slip and the end of its avalanche
-N_IST = 17
+EV_POS = 17  # events written to the catalogue buffer
+EV_ON = 18  # 1 while the event catalogue is recorded
+N_IST = 19
 
 N_AVALANCHE_BINS = 63  # avalanche sizes s are binned by floor(log2 s); 2**62 fits in int64
 
@@ -72,7 +75,8 @@ XG = 1  # centre-of-mass displacement / (Ntilde l0)
 MU_MAX = 2  # largest threshold mu_s
 U = 3  # run_pair only: the paper's u / Ntilde (spring length change)
 YG = 4  # run_vec only: centre-of-mass displacement along y / (Ntilde l0)
-N_FST = 5
+EV_T = 5  # time of the current driving event, in tau_th (q + fraction of the segment)
+N_FST = 6
 
 TILT_MAX_ITER = 1_000_000
 

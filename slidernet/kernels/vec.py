@@ -22,13 +22,16 @@ from __future__ import annotations
 
 import math
 
-from slidernet.kernels.heap import avalanche_done, heap_set, redraw_threshold
+from slidernet.kernels.heap import avalanche_done, heap_set, log_event, mu_stats, redraw_threshold
 from slidernet.kernels.state import (
     AV_SLIPS,
     AVALANCHE_LIMIT,
     DONE,
     DOWN_SIZE,
     ERR_NODE,
+    EV_ON,
+    EV_POS,
+    EV_T,
     HEAP_SIZE,
     IN_AVALANCHE,
     MU_MAX,
@@ -36,6 +39,7 @@ from slidernet.kernels.state import (
     N_EVENTS,
     N_RECORDS,
     N_SLIPS,
+    NEED_EVENTS,
     NEED_MU,
     REC,
     RECOMPUTE,
@@ -179,7 +183,7 @@ def init_vec_heaps(a, g, driven, mu, normal_load, hp, hv, hpos, ist, fst):
 
 @kernel_jit()
 def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load, w,
-          ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips):
+          ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
     fd = mu_d * normal_load[i]
     d = diagpos[i]  # the diagonal block K_ii
@@ -197,6 +201,7 @@ def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, 
         length = 2.0 * (absF - fd) / keff
         dux = length * ex
         duy = length * ey
+    log_event(i, dux, duy, ist, fst, ev_i, ev_f)
     u[i, 0] += dux
     u[i, 1] += duy
     for p in range(indptr[i], indptr[i + 1]):
@@ -221,14 +226,7 @@ def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu
     out_xg[k] = fst[XG]
     out_yg[k] = fst[YG]
     out_records[k] = ist[N_RECORDS]
-    # O(N) at record times only (log-spaced by default).
-    total = 0.0
-    low = mu[0]
-    for j in range(mu.size):
-        total += mu[j]
-        low = min(low, mu[j])
-    out_mu_mean[k] = total / mu.size
-    out_mu_min[k] = low
+    out_mu_mean[k], out_mu_min[k] = mu_stats(mu)
     ist[REC] = k + 1
 
 
@@ -236,7 +234,7 @@ def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu
 def run_vec(
     thetas, rec_times, mu, ist, fst, a, u, mu_buf, mu_d, max_slips, recompute_every, slip_mode,
     indptr, indices, kblk, diagpos, g, driven, normal_load, w, hp, hv, hpos, aval_hist,
-    node_slips, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
+    node_slips, ev_i, ev_f, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
 ):
     """Advance a 2D network through ``thetas`` (units of Ntilde).
 
@@ -267,9 +265,12 @@ def run_vec(
             if ist[MU_POS] >= mu_buf.size:
                 ist[AV_SLIPS] -= 1
                 return NEED_MU
+            if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
+                ist[AV_SLIPS] -= 1
+                return NEED_EVENTS
             absF = math.sqrt(Fx * Fx + Fy * Fy)
             if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load,
-                         w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips):
+                         w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
@@ -301,6 +302,8 @@ def run_vec(
                 fst[THETA] = thc
                 if ist[MU_POS] >= mu_buf.size:
                     return NEED_MU
+                if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
+                    return NEED_EVENTS
                 # At theta_c, |F| = mu_s N exactly; its direction is computed.
                 lim = mu[best] * normal_load[best]
                 Fx = a[best, 0] + g[best, 0] * thc
@@ -308,9 +311,10 @@ def run_vec(
                 ist[AV_SLIPS] = 0
                 ist[IN_AVALANCHE] = 1
                 ist[N_EVENTS] += 1
+                fst[EV_T] = q + (thc - thetas[q]) / (theta_b - thetas[q])
                 if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g, driven,
                              normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
-                             node_slips):
+                             node_slips, ev_i, ev_f):
                     ist[ERR_NODE] = best
                     return AVALANCHE_LIMIT
                 continue

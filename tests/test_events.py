@@ -1,0 +1,92 @@
+"""The event catalogue (observable ``events``): one row per slip, consistent with the records."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import slidernet
+from slidernet import solver
+from slidernet.config import load_config
+from slidernet.solver import Realization, Scene
+
+from .conftest import make_config
+
+NETWORKS = {
+    "chain": {"kind": "chain", "n": 6},
+    "triangular": {"kind": "triangular", "shape": [4, 5]},
+    "two_slider": {"kind": "two_slider"},
+}
+
+
+def events_config(net: dict, steps: int = 40, events: bool = True, **changes) -> dict:
+    obs = ["n", "mu_max", "x_G"] + (["events"] if events else [])
+    return make_config(**{"seed": 3, "realizations": 2, "steps": steps, "record": "all", "observables": obs,
+                          "network": {**net, "Ntilde": 1e-7}, "driver.sigma_theta": 3e-7, **changes})
+
+
+@pytest.fixture
+def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Many returns of the kernel to Python per run: exercises the buffer hand-over.
+    monkeypatch.setattr(solver, "EVENT_CHUNK", 64)
+
+
+@pytest.mark.parametrize("net", list(NETWORKS.values()), ids=list(NETWORKS))
+def test_the_catalogue_adds_up_to_the_records(net, small_chunks):
+    cfg = load_config(events_config(net))
+    r = Realization(Scene.from_config(cfg), np.random.SeedSequence(5)).advance()
+    res, ev = r.result(), r.events()
+    assert ev["node"].size == res["n"][-1] > 64 * 3
+    # Each slip counted once per node, and the centre of mass moves by the
+    # load-weighted sum of the slips.
+    np.testing.assert_array_equal(np.bincount(ev["node"], minlength=r.mu.size), res["node_slips"])
+    w = r.scene.network.normal_load / r.scene.network.normal_load.sum()
+    assert (w[ev["node"]] * ev["dx"]).sum() == pytest.approx(res["x_G"][-1], rel=1e-9, abs=1e-18)
+    # Time runs forward; avalanche ids count the driving events.
+    assert (np.diff(ev["time"]) >= 0).all() and ev["time"][0] >= 0 and ev["time"][-1] <= cfg.steps
+    assert (np.diff(ev["avalanche"]) >= 0).all()
+    assert np.unique(ev["avalanche"]).size == res["n_events"]
+    # The slips up to each recorded time are those with time <= t.
+    t = r.scene.rec_times
+    np.testing.assert_array_equal(np.searchsorted(ev["time"], t, side="right"), res["n"])
+
+
+@pytest.mark.parametrize("net", list(NETWORKS.values()), ids=list(NETWORKS))
+def test_the_catalogue_changes_no_result(net):
+    with_ev = slidernet.run(events_config(net))
+    without = slidernet.run(events_config(net, events=False))
+    for name in ("n", "mu_max", "x_G"):
+        np.testing.assert_array_equal(with_ev[name].values, without[name].values, err_msg=name)
+    assert "event" not in without.dims
+    assert with_ev.sizes["event"] == int(with_ev["n"].isel(t=-1).sum())
+    assert with_ev["events_complete"].values.tolist() == [1, 1]
+
+
+def test_a_two_slider_catalogue_runs_on_the_csr_kernel():
+    assert Scene.from_config(load_config(events_config(NETWORKS["two_slider"]))).kernel == "csr"
+    cfg = events_config(NETWORKS["two_slider"], **{"solver.kernel": "pair"})
+    with pytest.raises(slidernet.ConfigError, match=r"'events' observable .* needs a network kernel"):
+        load_config(cfg)
+
+
+def test_max_events_stops_the_catalogue_not_the_run(small_chunks):
+    base = events_config(NETWORKS["triangular"], **{"solver.max_events": 100})
+    with pytest.warns(RuntimeWarning, match=r"reached solver.max_events = 100 events at step \d+"):
+        capped = slidernet.run(base)
+    full = slidernet.run(events_config(NETWORKS["triangular"]))
+    np.testing.assert_array_equal(capped["n"].values, full["n"].values)
+    assert capped["events_complete"].values.tolist() == [0, 0]
+    assert capped.sizes["event"] == 200
+    first = full["event_node"].where(full["event_realization"] == 0, drop=True).values[:100]
+    np.testing.assert_array_equal(capped["event_node"].values[:100], first)
+
+
+def test_the_catalogue_is_written_to_netcdf(tmp_path):
+    from slidernet.io import read_result, write_netcdf
+
+    ds = slidernet.run(events_config(NETWORKS["triangular"], steps=10))
+    path = write_netcdf(ds, tmp_path / "result.nc")
+    back = read_result(path)
+    for name in ("event_time", "event_node", "event_avalanche", "event_dx", "event_dy", "event_realization"):
+        np.testing.assert_array_equal(back[name].values, ds[name].values, err_msg=name)
+    assert back["event_dx"].attrs["units"] == "l0"
