@@ -152,6 +152,12 @@ class Network:
             )
         self.positions = x
         self.edges = e
+        # Kept: K, g and the checks all need them, and at a million nodes
+        # recomputing them was a quarter of the setup.
+        length.flags.writeable = False
+        self._length = length
+        self._unit = dx / length[:, None]
+        self._unit.flags.writeable = False
         self.Ntilde = Ntilde
         self.k = _per_item(k, e.shape[0], "k", owner)
         if (self.k <= 0).any():
@@ -184,14 +190,12 @@ class Network:
         return self.edges.shape[0]
 
     def unit_vectors(self) -> np.ndarray:
-        """Unit vectors e_e from node i to node j of every spring, shape (E, d)."""
-        d = self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]]
-        return d / self.lengths()[:, None]
+        """Unit vectors e_e from node i to node j of every spring, shape (E, d) (read-only)."""
+        return self._unit
 
     def lengths(self) -> np.ndarray:
-        """Distances |X_j - X_i| of every spring's ends, in l0, shape (E,)."""
-        d = self.positions[self.edges[:, 1]] - self.positions[self.edges[:, 0]]
-        return np.abs(d[:, 0]) if self.dim == 1 else np.hypot(d[:, 0], d[:, 1])
+        """Distances |X_j - X_i| of every spring's ends, in l0, shape (E,) (read-only)."""
+        return self._length
 
     def incidence(self) -> sp.csr_matrix:
         """Oriented incidence matrix B times the unit vectors, shape (E, N d).
@@ -232,9 +236,8 @@ class Network:
         from slidernet.kernels.assembly import assemble_blocks
 
         N, d = self.n_nodes, self.dim
-        e = self.unit_vectors()
-        b = self.k[:, None, None] * e[:, :, None] * e[:, None, :]
-        indptr, indices, data, duplicate = assemble_blocks(N, self.edges[:, 0], self.edges[:, 1], b)
+        indptr, indices, data, duplicate = assemble_blocks(N, self.edges[:, 0], self.edges[:, 1], self.k,
+                                                           self.unit_vectors())
         if duplicate:  # parallel springs: let the sparse product sum them
             return self.stiffness_matrix().tobsr(blocksize=(d, d))
         return sp.bsr_matrix((data, indices, indptr), shape=(N * d, N * d), copy=False)

@@ -98,7 +98,8 @@ def _operators(net: Network) -> tuple[str, Any, dict[str, np.ndarray]]:
         "kblk": K.data,
         "diagpos": np.flatnonzero(indices == row).astype(np.int64),
         "g": g2,
-        "driven": (g2 != 0).any(axis=1),
+        "driven": (g2 != 0).any(axis=1),  # informative: the kernel reads g itself
+        "unit_load": bool((net.normal_load == 1.0).all()),
     }
 
 
@@ -343,7 +344,7 @@ class Realization:
     def _rebuild_heaps(self) -> None:
         o = self.scene.ops
         if self.scene.kernel == "vec":
-            kernels.init_vec_heaps(self.a, o["g"], o["driven"], self.mu, o["normal_load"], self.hp,
+            kernels.init_vec_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp,
                                    self.hv, self.hpos, self.ist, self.fst)
         else:
             kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hv,
@@ -433,7 +434,7 @@ class Realization:
         return kernels.run_vec(
             thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
             sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
-            o["indices"], o["kblk"], o["diagpos"], o["g"], o["driven"], o["normal_load"], o["w"], self.hp,
+            o["indices"], o["kblk"], o["diagpos"], o["g"], o["normal_load"], o["unit_load"], o["w"], self.hp,
             self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i, self.ev_f, out["n"], out["mu_max"],
             out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
         )

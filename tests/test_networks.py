@@ -112,15 +112,21 @@ def test_block_assembly_equals_the_sparse_product(kind):
     np.testing.assert_allclose(direct, product, rtol=0, atol=1e-13)
 
 
-def test_incremental_forces_do_not_drift():
-    # 1e5+ slips on a small triangular lattice: the incrementally updated
-    # forces stay within 1e-11 N of a fresh -K u + theta g.
-    cfg = network_config("triangular", 10.0, shape=[6, 6])
-    cfg["steps"] = 300
+@pytest.mark.slow
+def test_incremental_forces_do_not_drift_over_1e8_slips():
+    # 1e8 slips (about 70 s) on a 4 x 4 triangular lattice driven hard
+    # (sigma_theta / Ntilde = 30, ~6000 slips per tau_th), with the periodic
+    # recomputation off: the incrementally updated forces stay within 1e-9 N
+    # of a fresh -K u + theta g (measured: 2.5e-11 N with this seed, 2), and
+    # the int64 counters have room for 1e8 slips many times over.
+    cfg = network_config("triangular", 30.0, shape=[4, 4])
+    cfg["steps"] = 17_000
+    cfg["record"] = [0]
     cfg["solver"]["recompute_every"] = 0
     r = Realization(Scene.from_config(load_config(cfg)), np.random.SeedSequence(2)).advance()
-    assert r.n > 100_000
-    assert r.recompute_forces() < 1e-11
+    assert r.n >= 100_000_000
+    assert r.recompute_forces() < 1e-9
+    assert (np.linalg.norm(r.forces(), axis=1) <= r.thresholds * (1 + 1e-12)).all()
 
 
 def test_periodic_recomputation_keeps_the_physics():

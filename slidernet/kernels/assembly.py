@@ -12,10 +12,14 @@ from numba import njit
 
 
 @njit(cache=True)
-def _assemble(N, i, j, b, indptr):
-    """Fill the block rows of K (diagonal block first, then springs in edge order), then sort each row."""
+def _assemble(N, i, j, k, unit, indptr):
+    """Fill the block rows of K (diagonal block first, then springs in edge order), then sort each row.
+
+    Blocks are copied entry by entry: slicing a block would build an array
+    view per access, which cost most of the setup at a million nodes.
+    """
     nnz = indptr[N]
-    d = b.shape[1]
+    d = unit.shape[1]
     indices = np.empty(nnz, np.int64)
     data = np.empty((nnz, d, d))
     # The diagonal sums the i-side and the j-side separately, then adds them,
@@ -26,16 +30,21 @@ def _assemble(N, i, j, b, indptr):
     for e in range(i.size):
         a = i[e]
         c = j[e]
-        indices[fill[a]] = c
-        indices[fill[c]] = a
+        fa = fill[a]
+        fc = fill[c]
+        indices[fa] = c
+        indices[fc] = a
         for p in range(d):
             for q in range(d):
-                data[fill[a], p, q] = -b[e, p, q]
-                data[fill[c], p, q] = -b[e, p, q]
-                diag_i[a, p, q] += b[e, p, q]
-                diag_j[c, p, q] += b[e, p, q]
-        fill[a] += 1
-        fill[c] += 1
+                # The spring's block b_e = k_e e_e e_e^T, formed here: an (E, d, d)
+                # array of them would be 100 MB at a million nodes.
+                v = k[e] * unit[e, p] * unit[e, q]
+                data[fa, p, q] = -v
+                data[fc, p, q] = -v
+                diag_i[a, p, q] += v
+                diag_j[c, p, q] += v
+        fill[a] = fa + 1
+        fill[c] = fc + 1
     duplicate = False
     blk = np.empty((d, d))
     for n in range(N):
@@ -44,23 +53,32 @@ def _assemble(N, i, j, b, indptr):
         for p in range(d):
             for q in range(d):
                 data[start, p, q] = diag_i[n, p, q] + diag_j[n, p, q]
-        # Insertion sort by column: rows are short (the degree plus one).
+        # Insertion sort by column: rows are short (the degree plus one), and
+        # already sorted when the edges are (the lattices' are).
         for s in range(start + 1, indptr[n + 1]):
             col = indices[s]
-            blk[:, :] = data[s]
+            if indices[s - 1] < col:
+                continue
+            for p in range(d):
+                for q in range(d):
+                    blk[p, q] = data[s, p, q]
             t = s
             while t > start and indices[t - 1] > col:
                 indices[t] = indices[t - 1]
-                data[t] = data[t - 1]
+                for p in range(d):
+                    for q in range(d):
+                        data[t, p, q] = data[t - 1, p, q]
                 t -= 1
             indices[t] = col
-            data[t] = blk
+            for p in range(d):
+                for q in range(d):
+                    data[t, p, q] = blk[p, q]
             if t > start and indices[t - 1] == col:
                 duplicate = True
     return indices, data, duplicate
 
 
-def assemble_blocks(N: int, i: np.ndarray, j: np.ndarray, b: np.ndarray):
+def assemble_blocks(N: int, i: np.ndarray, j: np.ndarray, k: np.ndarray, unit: np.ndarray):
     """Block-CSR arrays of K from the spring blocks b_e = k_e e_e e_e^T.
 
     Parameters
@@ -69,8 +87,10 @@ def assemble_blocks(N: int, i: np.ndarray, j: np.ndarray, b: np.ndarray):
         Number of nodes.
     i, j : ndarray of int64, shape (E,)
         The two ends of every spring.
-    b : ndarray, shape (E, d, d)
-        Spring blocks, in units of k0.
+    k : ndarray, shape (E,)
+        Spring stiffnesses, in units of k0.
+    unit : ndarray, shape (E, d)
+        Unit vectors e_e from i to j; the spring's block is b_e = k_e e_e e_e^T.
 
     Returns
     -------
@@ -87,5 +107,6 @@ def assemble_blocks(N: int, i: np.ndarray, j: np.ndarray, b: np.ndarray):
     indptr = np.zeros(N + 1, np.int64)
     np.cumsum(degree + 1, out=indptr[1:])
     indices, data, duplicate = _assemble(N, i.astype(np.int64), j.astype(np.int64),
-                                         np.ascontiguousarray(b, dtype=np.float64), indptr)
+                                         np.ascontiguousarray(k, dtype=np.float64),
+                                         np.ascontiguousarray(unit, dtype=np.float64), indptr)
     return indptr, indices, data, bool(duplicate)

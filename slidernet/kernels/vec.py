@@ -154,35 +154,43 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd, px, py):
 
 
 @kernel_jit(inline="always")
-def update_node(j, theta, a, g, driven, mu, normal_load, hp, hv, hpos, ist):
+def update_node(j, theta, a, g, mu, normal_load, unit_load, hp, hv, hpos, ist):
     """Re-key node j in the three heaps after its force or threshold changed."""
-    Fx = a[j, 0] + g[j, 0] * theta
-    Fy = a[j, 1] + g[j, 1] * theta
+    gx = g[j, 0]
+    gy = g[j, 1]
+    Fx = a[j, 0] + gx * theta
+    Fy = a[j, 1] + gy * theta
     F2 = Fx * Fx + Fy * Fy  # forces are O(1) in these units: no overflow, hypot not needed
-    lim = mu[j] * normal_load[j]
+    # With unit loads (every lattice by default) the load array stays out of the cache.
+    lim = mu[j] if unit_load else mu[j] * normal_load[j]
     # Most updated nodes are stable and out of the heap: skip the call then.
     if F2 > lim * lim or hpos[j, 0] >= 0:
         F = math.sqrt(F2)
         heap_set(j, F / lim, F > lim, hp, hv, hpos, 0, ist, HEAP_SIZE)
-    if driven[j]:
-        dn, up = critical_thetas(a[j, 0], a[j, 1], g[j, 0], g[j, 1], lim)
+    # Driven nodes (g_j != 0) are those of the `driven` mask; reading g, already
+    # at hand, spares a cache line per neighbour.
+    if gx != 0.0 or gy != 0.0:
+        dn, up = critical_thetas(a[j, 0], a[j, 1], gx, gy, lim)
         heap_set(j, -up, True, hp, hv, hpos, 1, ist, UP_SIZE)
         heap_set(j, dn, True, hp, hv, hpos, 2, ist, DOWN_SIZE)
 
 
 @kernel_jit()
-def init_vec_heaps(a, g, driven, mu, normal_load, hp, hv, hpos, ist, fst):
+def init_vec_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
     """(Re)build the three heaps from scratch, O(N log N)."""
     hpos[:] = -1
     ist[HEAP_SIZE] = 0
     ist[UP_SIZE] = 0
     ist[DOWN_SIZE] = 0
+    unit_load = True
     for j in range(mu.size):
-        update_node(j, fst[THETA], a, g, driven, mu, normal_load, hp, hv, hpos, ist)
+        unit_load = unit_load and normal_load[j] == 1.0
+    for j in range(mu.size):
+        update_node(j, fst[THETA], a, g, mu, normal_load, unit_load, hp, hv, hpos, ist)
 
 
 @kernel_jit()
-def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load, w,
+def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load, w,
           ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
     fd = mu_d * normal_load[i]
@@ -214,7 +222,7 @@ def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, 
     redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
     theta = fst[THETA]
     for p in range(indptr[i], indptr[i + 1]):
-        update_node(indices[p], theta, a, g, driven, mu, normal_load, hp, hv, hpos, ist)
+        update_node(indices[p], theta, a, g, mu, normal_load, unit_load, hp, hv, hpos, ist)
     return True
 
 
@@ -233,14 +241,15 @@ def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu
 @kernel_jit()
 def run_vec(
     thetas, rec_times, mu, ist, fst, a, u, mu_buf, mu_d, max_slips, recompute_every, slip_mode,
-    indptr, indices, kblk, diagpos, g, driven, normal_load, w, hp, hv, hpos, aval_hist,
+    indptr, indices, kblk, diagpos, g, normal_load, unit_load, w, hp, hv, hpos, aval_hist,
     node_slips, ev_i, ev_f, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
 ):
     """Advance a 2D network through ``thetas`` (units of Ntilde).
 
     ``a``, ``u``, ``g`` have shape (N, 2); ``kblk`` (nnzb, 2, 2) holds the
     blocks K_ij of the block-CSR rows (``indptr``, ``indices``), and
-    ``diagpos[i]`` the position of K_ii. The
+    ``diagpos[i]`` the position of K_ii; ``unit_load`` is True when every
+    normal load is 1 (the array is then not read in the hot loop). The
     heaps must have been built by :func:`init_vec_heaps`; an unstable initial
     state (a large f_ext) is relaxed first.
     """
@@ -269,7 +278,7 @@ def run_vec(
                 ist[AV_SLIPS] -= 1
                 return NEED_EVENTS
             absF = math.sqrt(Fx * Fx + Fy * Fy)
-            if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, driven, normal_load,
+            if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load,
                          w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
@@ -312,8 +321,8 @@ def run_vec(
                 ist[IN_AVALANCHE] = 1
                 ist[N_EVENTS] += 1
                 fst[EV_T] = q + (thc - thetas[q]) / (theta_b - thetas[q])
-                if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g, driven,
-                             normal_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
+                if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g,
+                             normal_load, unit_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
                              node_slips, ev_i, ev_f):
                     ist[ERR_NODE] = best
                     return AVALANCHE_LIMIT
