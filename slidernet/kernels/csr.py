@@ -72,7 +72,7 @@ def init_csr_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
         update_node(j, theta, a, g, mu, normal_load, hp, hv, hpos, ist)
 
 
-@kernel_jit()
+@kernel_jit(inline="always")
 def _slip(i, Fi, absF, a, u, mu, indptr, indices, kdata, kdiag, g, normal_load, w,
           ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone (undamped half-oscillation); its threshold is redrawn."""

@@ -189,7 +189,7 @@ def init_vec_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
         update_node(j, fst[THETA], a, g, mu, normal_load, unit_load, hp, hv, hpos, ist)
 
 
-@kernel_jit()
+@kernel_jit(inline="always")
 def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load, w,
           ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
