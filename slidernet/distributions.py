@@ -160,3 +160,7 @@ class TruncatedBelow:
 
     def __repr__(self) -> str:
         return f"TruncatedBelow({self.dist!r}, lower={self.lower!r})"
+
+
+# The built-in distributions, by the name a config uses (``friction.static.name``).
+BUILTINS: dict[str, type] = {"gaussian": Gaussian}

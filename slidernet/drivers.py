@@ -48,3 +48,7 @@ class GaussianSteps:
 
     def __repr__(self) -> str:
         return f"GaussianSteps(sigma_theta={self.sigma_theta!r})"
+
+
+# The built-in drivers, by the name a config uses (``driver.name``).
+BUILTINS: dict[str, type] = {"gaussian_steps": GaussianSteps}

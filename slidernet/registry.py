@@ -133,15 +133,15 @@ def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str,
 
 
 def _builtin_distributions() -> dict[str, Factory]:
-    from slidernet.distributions import Gaussian
+    from slidernet.distributions import BUILTINS
 
-    return {"gaussian": Gaussian}
+    return BUILTINS
 
 
 def _builtin_drivers() -> dict[str, Factory]:
-    from slidernet.drivers import GaussianSteps
+    from slidernet.drivers import BUILTINS
 
-    return {"gaussian_steps": GaussianSteps}
+    return BUILTINS
 
 
 distributions = Registry("slidernet.distributions", "distribution", _builtin_distributions())
