@@ -37,13 +37,24 @@ NETWORKS = {
 @pytest.mark.parametrize(("F", "k"), [((0.6, 0.0), 3.0), ((0.3, 0.4), 2.0), ((-0.2, 0.7), 4.5)],
                          ids=["x", "oblique", "other"])
 def test_exact_slip_is_the_straight_half_oscillation_when_isotropic(F, k):
-    # Isotropic K_ii: the motion stays on the force line; length 2(|F| - fd)/k.
-    fd = 0.15
+    # Isotropic K_ii and |F| < 3 fd: the motion stays on the force line and
+    # stops at the first turning point; length 2(|F| - fd)/k.
+    fd = 0.25
     dx, dy, steps = exact_slip(F[0], F[1], k, 0.0, k, fd)
     absF = np.hypot(*F)
     expected = 2 * (absF - fd) / k * np.array(F) / absF
     assert steps > 0
     np.testing.assert_allclose([dx, dy], expected, rtol=1e-10, atol=1e-14)
+
+
+def test_exact_slip_slides_back_until_it_sticks_when_the_overload_is_large():
+    # |F| = 0.6 >= 3 fd = 0.45 along x with k = 3: the half-oscillation ends at
+    # 2 (0.6 - 0.15)/3 = 0.3 where G = -0.3, beyond fd; the node slides back by
+    # 2 (0.3 - 0.15)/3 = 0.1 and sticks at 0.2 with G = 0 (1D closed form).
+    dx, dy, steps = exact_slip(0.6, 0.0, 3.0, 0.0, 3.0, 0.15)
+    assert steps > 0
+    assert dx == pytest.approx(0.2, rel=1e-9)
+    assert dy == pytest.approx(0.0, abs=1e-14)
 
 
 def test_exact_slip_along_an_eigen_axis_uses_that_stiffness():
