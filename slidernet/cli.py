@@ -2,7 +2,9 @@
 
 ``slidernet run CONFIG.toml --out DIR``   writes DIR/result.nc
 ``slidernet paper [--quick] --out DIR``   reproduces the paper's four figures
-``slidernet plugins``                     lists the registered plugins
+``slidernet plugins``                     lists the registered plugins, where they come from
+``slidernet units --material steel --size 0.1 --delta-T 0.01``
+                                          Ntilde, sigma_theta and tau_th of a physical setup
 """
 
 from __future__ import annotations
@@ -11,8 +13,12 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from slidernet.errors import SlidernetError
+from slidernet.errors import SlidernetError, UnknownPluginError
+
+if TYPE_CHECKING:
+    from slidernet.registry import Registry
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -34,7 +40,24 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--out", type=Path, required=True, help="output directory")
     pp.add_argument("--quick", action="store_true", help="small preset (under 2 minutes)")
 
-    sub.add_parser("plugins", help="list the registered distributions and drivers")
+    sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
+
+    from slidernet.units import MATERIALS
+
+    u = sub.add_parser(
+        "units", help="turn a material and a setup into Ntilde, sigma_theta and tau_th",
+        description="Ntilde = rho g l0 / Y, sigma_theta = alpha delta_T and tau_th = l0^2 rho c / lambda "
+                    "(Geminard & Bertin 2010, section V), with a TOML snippet for a configuration.",
+    )
+    u.add_argument("--material", help=f"a preset ({', '.join(sorted(MATERIALS))}); explicit values override it")
+    u.add_argument("--size", type=float, required=True, help="slider size l0, m")
+    u.add_argument("--delta-T", dest="delta_T", type=float, help="temperature amplitude (standard deviation), K")
+    u.add_argument("--rho", type=float, help="density, kg/m^3")
+    u.add_argument("--Y", type=float, help="Young's modulus, Pa")
+    u.add_argument("--alpha", type=float, help="linear thermal expansion coefficient, 1/K")
+    u.add_argument("--conductivity", type=float, help="thermal conductivity, W/(m K)")
+    u.add_argument("--heat-capacity", dest="heat_capacity", type=float, help="specific heat capacity, J/(kg K)")
+    u.add_argument("--g", type=float, default=9.81, help="gravity, m/s^2 (default 9.81)")
     return p
 
 
@@ -64,15 +87,47 @@ def _cmd_plugins(args: argparse.Namespace) -> int:
 
     for reg in (registry.distributions, registry.drivers):
         print(f"{reg.kind}s ({reg.group}):")
-        for name in reg.names():
-            print(f"  {name}")
+        rows = [(name, *_plugin_origin(reg, name)) for name in reg.names()]
+        width = max((len(r[0]) for r in rows), default=0)
+        source_width = max((len(r[1]) for r in rows), default=0)
+        for name, origin, summary in rows:
+            print(f"  {name:<{width}}  {origin:<{source_width}}  {summary}".rstrip())
+    return 0
+
+
+def _plugin_origin(reg: Registry, name: str) -> tuple[str, str]:
+    """Where ``name`` comes from (built-in, an entry point's package, run time) and its summary."""
+    origin = reg.origin(name)
+    try:
+        factory = reg.get(name)
+    except UnknownPluginError:  # a broken package is listed (get warned), not fatal
+        return origin, f"FAILED TO LOAD {reg.load_error(name)}"
+    return origin, _summary(factory)
+
+
+def _summary(factory: object) -> str:
+    doc = getattr(factory, "__doc__", None)
+    lines = [line.strip() for line in (doc or "").strip().splitlines()]
+    return lines[0] if lines and lines[0] else "(no docstring)"
+
+
+def _cmd_units(args: argparse.Namespace) -> int:
+    from slidernet.units import setup
+
+    values = {k: getattr(args, k) for k in ("rho", "Y", "alpha", "conductivity", "heat_capacity")}
+    result = setup(args.material, size=args.size, delta_T=args.delta_T, g=args.g, **values)
+    print(result.summary())
+    print("\n# In a configuration (exact values):")
+    print(result.toml())
+    print("\n# or let slidernet compute them:")
+    print(result.units_toml())
     return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``slidernet`` command; returns the exit status."""
     args = _parser().parse_args(argv)
-    commands = {"run": _cmd_run, "paper": _cmd_paper, "plugins": _cmd_plugins}
+    commands = {"run": _cmd_run, "paper": _cmd_paper, "plugins": _cmd_plugins, "units": _cmd_units}
     try:
         return commands[args.command](args)
     except SlidernetError as exc:

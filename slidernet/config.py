@@ -30,9 +30,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
-from slidernet import registry
+from slidernet import registry, units
 from slidernet.distributions import TruncatedBelow
 from slidernet.errors import ConfigError
 
@@ -137,6 +137,101 @@ class FrictionConfig(_Strict):
     static: PluginSpec
 
 
+class UnitsConfig(_Strict):
+    """A physical setup from which ``network.Ntilde`` and ``driver.sigma_theta`` are computed.
+
+    A preset ``material`` (``steel``, ``glass``, ``granite``, ``pmma``) and/or
+    explicit values (they override the preset's): ``rho`` (kg/m^3), ``Y``
+    (Pa), ``alpha`` (1/K), ``conductivity`` (W/(m K)), ``heat_capacity``
+    (J/(kg K)); the slider ``size`` l0 (m); the temperature amplitude
+    ``delta_T`` (K, optional); gravity ``g`` (m/s^2, default 9.81). See
+    :mod:`slidernet.units` for the formulas (Ntilde = rho g l0 / Y,
+    sigma_theta = alpha delta_T).
+
+    The table fills ``network.Ntilde`` when [network] has none, and, when
+    ``delta_T`` is given, ``driver.sigma_theta`` when [driver] has none and
+    the driver takes a ``sigma_theta`` parameter. A value given both ways
+    must agree to a relative 1e-6 (so a resolved configuration, which keeps
+    both, loads again); otherwise the configuration is refused.
+    """
+
+    material: str | None = None
+    rho: PositiveFloat | None = None
+    Y: PositiveFloat | None = None
+    alpha: PositiveFloat | None = None
+    conductivity: PositiveFloat | None = None
+    heat_capacity: PositiveFloat | None = None
+    size: PositiveFloat
+    delta_T: PositiveFloat | None = None
+    g: PositiveFloat = units.G_STANDARD
+
+    @field_validator("material")
+    @classmethod
+    def _known_material(cls, value: str | None) -> str | None:
+        if value is not None:
+            try:
+                units.material(value)
+            except ConfigError as exc:
+                raise ValueError(str(exc).rstrip(".")) from None
+        return value
+
+    @model_validator(mode="after")
+    def _enough_values(self) -> UnitsConfig:
+        if self.material is None:
+            missing = [p for p in ("rho", "Y") if getattr(self, p) is None]
+            if missing:
+                raise ValueError(f"give a 'material' or explicit {' and '.join(repr(p) for p in missing)}")
+            if self.delta_T is not None and self.alpha is None:
+                raise ValueError("'delta_T' needs 'alpha' (or a 'material') to give sigma_theta")
+        return self
+
+    def resolve(self) -> units.Dimensionless:
+        """Ntilde, sigma_theta (None without delta_T), tau_th and their ratio."""
+        values = {p: getattr(self, p) for p in ("rho", "Y", "alpha", "conductivity", "heat_capacity")}
+        return units.setup(self.material, size=self.size, delta_T=self.delta_T, g=self.g, **values)
+
+
+_UNITS_RTOL = 1e-6
+
+
+def _takes_sigma_theta(name: object) -> bool | None:
+    """Whether the driver called ``name`` takes a ``sigma_theta`` parameter; None if unknown."""
+    if not isinstance(name, str):
+        return None
+    try:
+        factory = registry.drivers.get(name)
+    except ConfigError:
+        return None
+    try:
+        params = inspect.signature(factory).parameters
+    except (TypeError, ValueError):  # pragma: no cover - no introspectable signature
+        return True
+    return "sigma_theta" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def _fill_from_units(data: Any) -> Any:
+    """A copy of the raw config with the values its [units] table gives filled in where absent."""
+    if not isinstance(data, Mapping) or not isinstance(data.get("units"), (Mapping, UnitsConfig)):
+        return data
+    data = dict(data)
+    network = data.get("network", {})
+    try:
+        found = UnitsConfig.model_validate(data["units"]).resolve()
+    except (ValidationError, ConfigError):
+        # The 'units' field reports the error; a placeholder keeps a missing Ntilde
+        # from adding a second, misleading message (this config is refused anyway).
+        if isinstance(network, Mapping) and "Ntilde" not in network:
+            data["network"] = {**network, "Ntilde": 1.0}
+        return data
+    if isinstance(network, Mapping) and "Ntilde" not in network:
+        data["network"] = {**network, "Ntilde": found.Ntilde}
+    driver = data.get("driver")
+    if found.sigma_theta is not None and isinstance(driver, Mapping) and "sigma_theta" not in driver \
+            and _takes_sigma_theta(driver.get("name")):
+        data["driver"] = {**driver, "sigma_theta": found.sigma_theta}
+    return data
+
+
 class SolverConfig(_Strict):
     """Choices of the quasi-static solver.
 
@@ -167,6 +262,10 @@ class Config(_Strict):
     of sliders), ``"records"`` once per realization at every recorded time
     (the network tilt test, any network), ``"auto"`` the first where it
     applies and the second otherwise.
+
+    ``units`` (optional, :class:`UnitsConfig`) computes ``network.Ntilde``
+    and ``driver.sigma_theta`` from a material, a slider size and a
+    temperature amplitude, where they are not given.
     """
 
     seed: Annotated[int, Field(ge=0)] | None = None
@@ -178,6 +277,7 @@ class Config(_Strict):
         default_factory=lambda: ["n", "mu_max", "x_G"]
     )
     mu_eff_at: Literal["auto", "rearrangements", "records"] = "auto"
+    units: UnitsConfig | None = None
     network: NetworkConfig
     friction: FrictionConfig
     driver: PluginSpec
@@ -185,6 +285,42 @@ class Config(_Strict):
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _units_fill(cls, data: Any) -> Any:
+        return _fill_from_units(data)
+
+    @model_validator(mode="after")
+    def _units_agree(self) -> Config:
+        if self.units is None:
+            return self
+        found = self.units.resolve()
+        if not math.isclose(self.network.Ntilde, found.Ntilde, rel_tol=_UNITS_RTOL):
+            raise ValueError(
+                f"'network.Ntilde' = {self.network.Ntilde!r} disagrees with [units], which gives "
+                f"Ntilde = rho g l0 / Y = {found.Ntilde!r}; give one of them, or the same value"
+            )
+        if found.sigma_theta is None:
+            return self
+        given = self.driver.params.get("sigma_theta")
+        if given is None:
+            if _takes_sigma_theta(self.driver.name) is False:
+                raise ValueError(
+                    f"'units.delta_T' gives sigma_theta = {found.sigma_theta!r}, but the driver "
+                    f"{self.driver.name!r} takes no 'sigma_theta' parameter; remove 'delta_T'"
+                )
+            return self  # an unknown driver: load_config names it
+        try:
+            given = float(given)
+        except (TypeError, ValueError):
+            return self  # the driver itself refuses it, naming the parameter
+        if not math.isclose(given, found.sigma_theta, rel_tol=_UNITS_RTOL):
+            raise ValueError(
+                f"'driver.sigma_theta' = {given!r} disagrees with [units], which gives "
+                f"sigma_theta = alpha delta_T = {found.sigma_theta!r}; give one of them, or the same value"
+            )
+        return self
 
     @model_validator(mode="after")
     def _check_cross_fields(self) -> Config:
