@@ -56,6 +56,7 @@ class Registry:
         self._runtime: dict[str, Factory] = {}
         self._entry_points: dict[str, EntryPoint] | None = None
         self._loaded: dict[str, Factory] = {}
+        self._errors: dict[str, str] = {}
 
     def _discover(self) -> dict[str, EntryPoint]:
         if self._entry_points is None:
@@ -93,6 +94,7 @@ class Registry:
             try:
                 factory = ep.load()
             except Exception as exc:  # a broken third-party package must not break the registry
+                self._errors[name] = f"({ep.value}): {exc!r}"
                 warnings.warn(
                     f"The {self.kind} plugin {name!r} ({ep.value}) failed to load: {exc!r}",
                     RuntimeWarning,
@@ -104,6 +106,27 @@ class Registry:
         available = ", ".join(repr(n) for n in self.names())
         raise UnknownPluginError(f"Unknown {self.kind} {name!r}. Available: {available}.")
 
+    def load_error(self, name: str) -> str | None:
+        """Why the entry point ``name`` failed to load (its target and exception), or None."""
+        return self._errors.get(name)
+
+    def origin(self, name: str) -> str:
+        """Where ``name`` comes from: ``"run time"``, ``"built-in"``, or the package of its entry point.
+
+        >>> distributions.origin("gaussian")
+        'built-in'
+        """
+        if name in self._runtime:
+            return "run time"
+        if name in self._builtins:
+            return "built-in"
+        ep = self._discover().get(name)
+        if ep is None:
+            available = ", ".join(repr(n) for n in self.names())
+            raise UnknownPluginError(f"Unknown {self.kind} {name!r}. Available: {available}.")
+        dist = getattr(ep, "dist", None)
+        return f"{dist.name} {dist.version}" if dist is not None else f"entry point {ep.value}"
+
     def create(self, name: str, **params: Any) -> Any:
         """Look up ``name`` and call its factory with ``params``."""
         return self.get(name)(**params)
@@ -112,6 +135,7 @@ class Registry:
         """Forget discovered entry points (for tests and for newly installed packages)."""
         self._entry_points = None
         self._loaded.clear()
+        self._errors.clear()
 
 
 def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str, call: str) -> np.ndarray:

@@ -67,16 +67,18 @@ class FixedThetas:
 
 def _snapshot(reg: registry.Registry) -> tuple:
     eps = None if reg._entry_points is None else dict(reg._entry_points)
-    return dict(reg._runtime), eps, dict(reg._loaded)
+    return dict(reg._runtime), eps, dict(reg._loaded), dict(reg._errors)
 
 
 def _restore(reg: registry.Registry, state: tuple) -> None:
-    runtime, eps, loaded = state
+    runtime, eps, loaded, errors = state
     reg._runtime.clear()
     reg._runtime.update(runtime)
     reg._entry_points = eps
     reg._loaded.clear()
     reg._loaded.update(loaded)
+    reg._errors.clear()
+    reg._errors.update(errors)
 
 
 @pytest.fixture
