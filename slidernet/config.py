@@ -446,12 +446,14 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
         except tomllib.TOMLDecodeError as exc:
             raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
-        # A graph file named in a config file is found next to that file.
-        network = source.get("network")
-        if isinstance(network, dict) and isinstance(network.get("path"), str):
-            graph = Path(network["path"])
-            if not graph.is_absolute():
-                network["path"] = str(path.parent / graph)
+        # Files named in a config file (a graph, a temperature series, measured
+        # thresholds) are found next to that file.
+        tables = (source.get("network"), source.get("driver"), (source.get("friction") or {}).get("static"))
+        for table in tables:
+            if isinstance(table, dict) and isinstance(table.get("path"), str):
+                named = Path(table["path"])
+                if not named.is_absolute():
+                    table["path"] = str(path.parent / named)
     if isinstance(source, Config):
         cfg = source
     else:
@@ -464,7 +466,15 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
             raise ConfigError(f"Invalid configuration:\n{lines}") from None
     cfg.distribution()
-    cfg.driver_plugin()
+    driver = cfg.driver_plugin()
+    # An optional hook: a driver that cannot cover the run (a recorded series
+    # too short) says so now, before any work.
+    check = getattr(driver, "check_steps", None)
+    if check is not None:
+        try:
+            check(cfg.steps)
+        except ConfigError as exc:
+            raise ConfigError(f"The 'driver' field: {exc}") from None
     return cfg
 
 

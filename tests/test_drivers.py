@@ -375,3 +375,23 @@ def test_driver_parameters_are_checked_through_the_config():
     with pytest.raises(ConfigError, match=r"'driver' field: The 'tau_c' parameter of ornstein_uhlenbeck "
                                           r"must be > 0\. Got 0\.0 instead\."):
         slidernet.load_config(cfg)
+
+
+def test_a_series_named_in_a_config_file_is_found_next_to_it(tmp_path):
+    # The TOML names "T.csv"; the run happens from another working directory.
+    write_csv(tmp_path / "T.csv", "0,20.0\n1,20.5\n2,19.0\n3,21.0\n")
+    (tmp_path / "run.toml").write_text(
+        'steps = 3\nrecord = "all"\n[network]\nkind = "two_slider"\nNtilde = 1e-7\n'
+        '[friction]\nmu_d = 0.5\n[friction.static]\nname = "gaussian"\nmean = 0.6\nstd = 0.01\n'
+        '[driver]\nname = "series"\npath = "T.csv"\nkappa = 1e-6\nT0 = 20.0\ntau_th = 1.0\n'
+    )
+    cfg = slidernet.load_config(tmp_path / "run.toml")
+    assert Path(cfg.driver.params["path"]) == tmp_path / "T.csv"
+
+
+def test_a_series_too_short_for_the_run_is_refused_when_the_config_loads(tmp_path):
+    path = write_csv(tmp_path / "T.csv", "0,20.0\n1,20.5\n2,19.0\n")
+    cfg = make_config(steps=50, driver={"name": "series", "path": str(path), "kappa": 1e-6, "T0": 20.0,
+                                        "tau_th": 1.0})
+    with pytest.raises(ConfigError, match=r"The 'driver' field: .* covers 2 steps .* 50 steps were asked for"):
+        slidernet.load_config(cfg)
