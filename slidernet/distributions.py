@@ -173,6 +173,9 @@ class Distribution:
 
     name = "distribution"
     _mu_d_param = "loc"
+    # Every built-in is conditioned on mu_s > mu_d by TruncatedBelow (rejection):
+    # a law whose support starts above mu_d loses nothing.
+    truncate_below_mu_d: ClassVar[bool] = True
 
     def support(self) -> tuple[float, float]:
         """Lower and upper end of the support (may be infinite)."""
@@ -920,11 +923,16 @@ distribution of scipy.stats (e.g. 'gamma'). Got 'poisson' instead.
 
 
 class TruncatedBelow:
-    """A distribution conditioned on mu_s > ``lower`` (normally mu_d).
+    """A distribution conditioned on mu_s > ``lower`` (normally mu_d), or checked to be.
 
-    Sampling is by rejection in batches, so a plugin written in plain numpy
-    stays fast. A plugin whose mass above ``lower`` is below ``min_mass`` is
-    refused, since rejection would then never end.
+    The model needs p(mu_s) = 0 for mu_s <= mu_d. A plugin that declares
+    ``truncate_below_mu_d = True`` (every built-in does) is conditioned on
+    mu_s > lower: sampling is by rejection in batches, so a plugin written in
+    plain numpy stays fast, and one whose mass above ``lower`` is below
+    ``min_mass`` is refused, since rejection would then never end. Any other
+    plugin must put no mass at or below ``lower``: its ``sf(lower)`` must be
+    1 (checked here, before any work), and a draw at or below ``lower`` stops
+    the run with a :class:`~slidernet.errors.PluginError` naming the plugin.
 
     Parameters
     ----------
@@ -955,6 +963,13 @@ class TruncatedBelow:
         self.lower = float(lower)
         self.name = name
         mass = float(self._raw_sf(self.lower))
+        self.truncate = bool(getattr(dist, "truncate_below_mu_d", False))
+        if not self.truncate and not mass >= 1.0 - 1e-12:
+            raise ConfigError(
+                f"The distribution {name!r} puts probability {1.0 - mass!r} at or below mu_d = {lower!r}, "
+                "but p(mu_s) must vanish for mu_s <= mu_d. Move its support above mu_d, or declare "
+                "'truncate_below_mu_d = True' on its factory to have slidernet condition it on mu_s > mu_d."
+            )
         if not (mass >= min_mass):
             raise ConfigError(
                 f"The distribution {name!r} puts probability {mass!r} above mu_d = {lower!r}; "
@@ -978,6 +993,14 @@ class TruncatedBelow:
         """``size`` draws strictly above ``lower``, shape ``(size,)``."""
         out = self._checked(self.dist.sample(rng, size), size)
         bad = np.flatnonzero(out <= self.lower)
+        if bad.size and not self.truncate:
+            from slidernet.errors import PluginError
+
+            raise PluginError(
+                f"The distribution {self.name!r} returned {bad.size} values at or below mu_d = {self.lower!r} "
+                f"from sample(rng, {size}) (the first: {float(out[bad[0]])!r}), although its cdf puts no "
+                "mass there; p(mu_s) must vanish for mu_s <= mu_d."
+            )
         while bad.size:
             # Ask for extra draws so that the loop ends in one or two passes.
             want = int(bad.size / self.acceptance * 1.2) + 8

@@ -282,7 +282,7 @@ use only the Generator it is given.
 
 def _check_truncation(dist: Any, mu_d: float, label: str, name: str | None, seed: int, size: int) -> None:
     from slidernet.distributions import TruncatedBelow
-    from slidernet.errors import ConfigError
+    from slidernet.errors import ConfigError, PluginError
 
     check = getattr(dist, "check_mu_d", None)
     if check is not None:
@@ -295,7 +295,10 @@ def _check_truncation(dist: Any, mu_d: float, label: str, name: str | None, seed
     except ConfigError as exc:
         raise PluginContractError(f"{label}: cannot be truncated below mu_d = {mu_d!r}: {exc}") from None
     with _GlobalRNGGuard(label, "sample(rng, n) truncated below mu_d"):
-        kept = trunc.sample(np.random.default_rng(seed), size)
+        try:
+            kept = trunc.sample(np.random.default_rng(seed), size)
+        except PluginError as exc:
+            raise PluginContractError(f"{label}: {exc}") from None
     if not (kept > mu_d).all():  # pragma: no cover - TruncatedBelow guarantees it
         raise PluginContractError(f"{label}: truncated draws at or below mu_d = {mu_d!r}.")
 

@@ -468,6 +468,8 @@ def test_mean_max_matches_monte_carlo(case, data_file):
 class CdfOnlyUniform:
     """A third-party plugin with sample and cdf only (no sf, isf nor mean_max)."""
 
+    truncate_below_mu_d = True  # its support starts below mu_d: slidernet conditions it
+
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         return rng.uniform(0.45, 0.65, size)
 
@@ -567,3 +569,31 @@ def test_extreme_value_classes_example_quick(tmp_path, capsys):
     # The three classes: bounded (uniform, z -> 1), logarithmic (exponential), power law (pareto).
     z = late["z_exact"].sel(law=["uniform", "exponential", "pareto"]).values
     assert z[0] < 1 < z[1] < z[2]
+
+
+class BelowMuD:
+    """A third-party plugin that reaches below mu_d without asking for truncation."""
+
+    def __init__(self, lie: bool = False) -> None:
+        self.lie = lie
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        return rng.uniform(0.45, 0.65, size)
+
+    def cdf(self, x):
+        # lie: a cdf that claims no mass at or below mu_d while the draws go there.
+        low = 0.5 if self.lie else 0.45
+        return np.clip((np.asarray(x, dtype=float) - low) / (0.65 - low), 0.0, 1.0)
+
+
+def test_a_plugin_with_mass_at_or_below_mu_d_is_refused_before_any_work():
+    with pytest.raises(ConfigError, match=r"'below' puts probability 0\.25 at or below mu_d = 0\.5, .*"
+                                          r"'truncate_below_mu_d = True'"):
+        TruncatedBelow(BelowMuD(), MU_D, "below")
+
+
+def test_a_plugin_that_draws_at_or_below_mu_d_is_stopped_naming_it():
+    d = TruncatedBelow(BelowMuD(lie=True), MU_D, "liar")
+    with pytest.raises(slidernet.PluginError, match=r"The distribution 'liar' returned \d+ values at or below "
+                                                    r"mu_d = 0\.5 from sample\(rng, 100\)"):
+        d.sample(np.random.default_rng(0), 100)

@@ -155,7 +155,7 @@ def test_check_distribution_catches(cls, match):
 
 def test_check_distribution_refuses_a_law_without_mass_above_mu_d():
     with pytest.raises(PluginContractError, match=r"cannot be truncated below mu_d = 0\.5: The distribution "
-                                                  r"'low' puts probability 0\.0 above mu_d"):
+                                                  r"'low' puts probability 1\.0 at or below mu_d"):
         check_distribution(FakeDist, {"low": 0.1, "high": 0.4}, mu_d=0.5, name="low")
 
 

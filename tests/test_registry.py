@@ -155,5 +155,5 @@ def test_distribution_without_mass_above_mu_d_is_refused(clean_registries):
     slidernet.register_distribution("low", FakeDist)
     cfg = make_config(**SMALL, **{"friction.static": {"name": "low", "low": 0.1, "high": 0.4}})
     with pytest.raises(slidernet.ConfigError, match=r"'friction\.static' field: The distribution 'low' puts "
-                                                    r"probability 0\.0 above mu_d = 0\.5"):
+                                                    r"probability 1\.0 at or below mu_d = 0\.5"):
         load_config(cfg)

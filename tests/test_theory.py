@@ -30,6 +30,8 @@ MU_S_MEAN = 0.6
 class CdfOnlyGaussian:
     """A plugin with ``sample`` and ``cdf`` only: no ``sf``, no ``lower``."""
 
+    truncate_below_mu_d = True  # its tail reaches below mu_d: conditioned by slidernet
+
     def __init__(self, mean: float, std: float) -> None:
         self.mean = mean
         self.std = std

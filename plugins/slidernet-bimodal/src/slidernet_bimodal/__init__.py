@@ -64,6 +64,8 @@ class Bimodal:
         "mean1": 0.58, "std1": 0.01, "mean2": 0.62, "std2": 0.005, "weight": 0.7,
     }
     example_mu_d: ClassVar[float] = 0.5
+    #: Gaussian tails reach below mu_d: slidernet conditions the law on mu_s > mu_d.
+    truncate_below_mu_d: ClassVar[bool] = True
 
     def __init__(self, mean1: float, std1: float, mean2: float, std2: float, weight: float = 0.5) -> None:
         self.mean1 = _finite(mean1, "mean1")
