@@ -41,6 +41,10 @@ __all__ = [
 ]
 
 
+_SUBMODULES = {"builders", "distributions", "drivers", "io", "network", "observables", "plots", "registry",
+               "solver", "testing", "theory", "units"}
+
+
 def __getattr__(name: str):
     # Lazy: importing slidernet should not import numba and compile kernels.
     if name == "run":
@@ -51,4 +55,8 @@ def __getattr__(name: str):
         from slidernet.config import load_config
 
         return load_config
+    if name in _SUBMODULES:  # slidernet.testing etc. without an explicit import, as in scipy
+        import importlib
+
+        return importlib.import_module(f"slidernet.{name}")
     raise AttributeError(f"module 'slidernet' has no attribute {name!r}")

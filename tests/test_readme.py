@@ -28,3 +28,12 @@ def test_api_example_runs_as_written(tmp_path, monkeypatch, capsys):
     assert 0.6 < mu_max < 0.7
     assert 0.5 < mu_eff < 0.7
     assert (tmp_path / "result.nc").exists()
+
+
+def test_plugin_example_runs_as_written(clean_registries):
+    text = README.read_text(encoding="utf-8").split("**Your own plugin.**", 1)[1]
+    code = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    exec(compile(code, "README.md", "exec"), {})
+    from slidernet import registry
+
+    assert registry.distributions.origin("my_uniform") == "run time"
