@@ -549,7 +549,11 @@ class Realization:
                     f"An avalanche did not end after {sc.max_avalanche} slips "
                     f"(solver.max_avalanche), or a slip did not come to rest, during step "
                     f"{ist[kernels.Q]}: node {i} is unstable with F = {force} N, "
-                    f"mu_s = {float(self.mu[i])!r}, theta = {self.theta!r}."
+                    f"mu_s = {float(self.mu[i])!r}, theta = {self.theta!r}. "
+                    + ("A load f_ext that friction cannot hold makes the network (or a floppy part of it, "
+                       "such as a row of a square lattice) slide for ever: lower f_ext. "
+                       if self.scene.network.f_ext.any() else "")
+                    + "A genuinely long avalanche needs a larger solver.max_avalanche."
                 )
             elif status == kernels.TILT_LIMIT:
                 raise TiltTestError(
