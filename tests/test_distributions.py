@@ -7,9 +7,7 @@ hold for most seeds too.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +37,7 @@ from slidernet.distributions import (
 )
 from slidernet.errors import ConfigError
 from tests.conftest import make_config
+from tests.test_examples import load_example
 
 MU_D = 0.5
 NTILDE = 1e-7
@@ -530,22 +529,8 @@ def test_mu_max_is_the_maximum_of_n_plus_2_draws(case, steps, data_file):
 # the example
 
 
-def _load_example(name: str):
-    path = Path(__file__).resolve().parent.parent / "examples" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(f"slidernet_example_{name}", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[spec.name]
-        raise
-    return module
-
-
 def test_extreme_value_classes_example_quick(tmp_path, capsys):
-    example = _load_example("extreme_value_classes")
+    example = load_example("extreme_value_classes")
     with pytest.raises(SystemExit) as exc:
         example.main(["--help"])
     assert exc.value.code == 0

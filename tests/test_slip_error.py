@@ -51,8 +51,8 @@ def _straight(F: np.ndarray, k: np.ndarray) -> np.ndarray:
     return se.straight_slip(F[None, :], k[None, :, :], MU_D)[0]
 
 
-def _reference(F: np.ndarray, k: np.ndarray, **kw: float) -> np.ndarray:
-    dx, dy, steps = se.reference_slip(F[0], F[1], k[0, 0], k[0, 1], k[1, 1], MU_D, **kw)
+def _reference(F: np.ndarray, k: np.ndarray, steps_per_period: int = 4000, c: float = 0.5) -> np.ndarray:
+    dx, dy, steps = se.reference_slip(F[0], F[1], k[0, 0], k[0, 1], k[1, 1], MU_D, steps_per_period, c)
     assert steps > 0, "the reference did not stop"
     return np.array([dx, dy])
 

@@ -85,14 +85,21 @@ def critical_thetas(ax, ay, gx, gy, lim):
 
 @kernel_jit()
 def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
+    """The exact 2D slip of the kernels: :func:`integrate_slip` at its default resolution."""
+    return integrate_slip(Fx, Fy, kxx, kxy, kyy, fd, _STEPS_PER_PERIOD, 0.5)
+
+
+@kernel_jit()
+def integrate_slip(Fx, Fy, kxx, kxy, kyy, fd, steps_per_period, c):
     """Displacement of a node sliding from rest under F - K x and friction fd (2D, unit mass).
 
     The motion x'' = F - K x - fd v/|v| (the other nodes fixed) is integrated
     by RK4 from rest until the node sticks: its speed vanishes where the
     elastic force G = F - K x is at most fd. The direction of the friction
     turns at the rate |G|/|v|, which is stiff where the speed is small, so
-    the step is h = min(h_max, 0.5 |v| / (|G| + fd)) with h_max = (period of
-    the stiffest mode) / 4000; the first instant, still along F, is taken
+    the step is h = min(h_max, c |v| / (|G| + fd)) with h_max = (period of
+    the stiffest mode) / ``steps_per_period`` (c, about the largest turn of
+    the velocity per step in radians); the first instant, still along F, is taken
     from the short-time solution; the last stretch, once |G| < fd and the
     remaining speed is gone within h_max, is taken at constant deceleration.
     A fixed-step version of this integration (before 0.2) could creep instead
@@ -108,14 +115,16 @@ def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
     motion into separate rearrangements, each redrawing the threshold).
 
     Returns (dx, dy, steps); steps < 0 if the node had not stuck within the
-    step budget (``_MAX_PERIODS`` periods of the softest mode, at most 5e7 steps).
+    step budget (``_MAX_PERIODS`` periods of the softest mode, at most 5e7
+    steps). benchmarks/slip_error.py checks convergence against
+    ``steps_per_period = 16000, c = 0.125``.
     """
     root = math.sqrt(0.25 * (kxx - kyy) ** 2 + kxy * kxy)
     lam = 0.5 * (kxx + kyy) + root
     lam_soft = max(0.5 * (kxx + kyy) - root, 1e-12 * lam)
-    h_max = 2.0 * math.pi / math.sqrt(lam) / _STEPS_PER_PERIOD
+    h_max = 2.0 * math.pi / math.sqrt(lam) / steps_per_period
     # A soft direction slows the motion down: budget periods of the softest mode.
-    budget = int(_STEPS_PER_PERIOD * _MAX_PERIODS * max(1.0, math.sqrt(lam / lam_soft)))
+    budget = int(steps_per_period * _MAX_PERIODS * max(1.0, math.sqrt(lam / lam_soft)))
     budget = min(budget, 50_000_000)
     absF = math.hypot(Fx, Fy)
     a0 = absF - fd
@@ -163,7 +172,7 @@ def exact_slip(Fx, Fy, kxx, kxy, kyy, fd):
                 vx = a0 * t0 * Gx / G
                 vy = a0 * t0 * Gy / G
                 continue
-        h = min(h_max, 0.5 * sp / (G + fd))
+        h = min(h_max, c * sp / (G + fd))
         a1x, a1y = _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd)
         k2x = vx + 0.5 * h * a1x
         k2y = vy + 0.5 * h * a1y
