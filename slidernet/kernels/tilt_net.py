@@ -55,7 +55,7 @@ import math
 
 from slidernet.kernels.heap import heap_set
 from slidernet.kernels.state import kernel_jit
-from slidernet.kernels.vec import SLIP_EXACT, exact_slip
+from slidernet.kernels.vec import SLIP_EXACT, exact_slip, straight_slip
 
 # Return codes (negative: no sample).
 TILT_NEED_DRAWS = -1.0
@@ -203,13 +203,7 @@ def tilt_test_network(G, mu, normal_load, f_ext, f_bar, indptr, indices, kblk, d
                 pos[N_SLIPS] = slips
                 return TILT_TOO_LONG
         else:
-            Tn = math.sqrt(Tx * Tx + Ty * Ty)
-            ex = Tx / Tn
-            ey = Ty / Tn
-            keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
-            length = 2.0 * (T - fd) / keff
-            dux = length * ex
-            duy = length * ey
+            dux, duy = straight_slip(Tx, Ty, math.sqrt(Tx * Tx + Ty * Ty), T, kxx, kxy, kyy, fd)
         for p in range(indptr[i], indptr[i + 1]):
             j = indices[p]
             G[j, 0] -= kblk[p, 0, 0] * dux + kblk[p, 0, 1] * duy

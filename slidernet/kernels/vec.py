@@ -241,6 +241,20 @@ def init_vec_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
 
 
 @kernel_jit(inline="always")
+def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
+    """The straight-line slip: 2 (mag - fd) / k_eff along F / norm, k_eff = e^T K_ii e.
+
+    ``norm`` is |F| as computed, ``mag`` the force magnitude the slip starts
+    from (mu_s N exactly at a driving event, |F| in an avalanche).
+    """
+    ex = Fx / norm
+    ey = Fy / norm
+    keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
+    length = 2.0 * (mag - fd) / keff
+    return length * ex, length * ey
+
+
+@kernel_jit(inline="always")
 def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load, w,
           ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
     """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
@@ -254,12 +268,7 @@ def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_l
         if nsteps < 0:
             return False
     else:
-        ex = Fx / absF
-        ey = Fy / absF
-        keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
-        length = 2.0 * (absF - fd) / keff
-        dux = length * ex
-        duy = length * ey
+        dux, duy = straight_slip(Fx, Fy, absF, absF, kxx, kxy, kyy, fd)
     log_event(i, dux, duy, ist, fst, ev_i, ev_f)
     u[i, 0] += dux
     u[i, 1] += duy
