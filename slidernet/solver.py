@@ -14,7 +14,7 @@ one rearrangement to the next by solving eq. `critique` exactly.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -238,12 +238,25 @@ def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random
     ``seed_seq.spawn(3)`` gives, in order: the driver, the thresholds of the
     horizontal evolution, and the virtual tilt test. The tilt test never
     touches the other two, so requesting ``mu_eff`` leaves n, mu_max and x_G
-    unchanged to the bit.
+    unchanged to the bit. The same ``seed_seq`` always gives the same
+    streams, even after it has been spawned from.
+
+    Examples
+    --------
+    >>> ss = np.random.SeedSequence(1)
+    >>> a = realization_streams(ss)["driver"].random()
+    >>> a == realization_streams(ss)["driver"].random()
+    True
     """
     names = ("driver", "thresholds", "tilt")
+    # spawn() is stateful: a second call on the same SeedSequence gives other
+    # children. Spawning from a pristine copy makes a realization a function
+    # of its seed alone, however often that seed is used (reruns, comparisons).
+    pristine = np.random.SeedSequence(seed_seq.entropy, spawn_key=seed_seq.spawn_key,
+                                      pool_size=seed_seq.pool_size)
     return {
         name: np.random.Generator(np.random.PCG64(child))
-        for name, child in zip(names, seed_seq.spawn(3), strict=True)
+        for name, child in zip(names, pristine.spawn(3), strict=True)
     }
 
 
@@ -252,6 +265,39 @@ def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
     thetas = checked_output(scene.driver.thetas(rng, scene.steps), (scene.steps + 1,), "driver",
                             scene.driver_name, f"thetas(rng, {scene.steps})")
     return thetas
+
+
+def horizontal_draws(scene: Scene, rngs: dict[str, np.random.Generator]) -> tuple[
+        np.ndarray, np.ndarray, Iterator[np.ndarray]]:
+    """The draws of a realization's horizontal evolution, in the order the solver reads them.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    rngs : dict of str to Generator
+        The realization's streams (:func:`realization_streams`).
+
+    Returns
+    -------
+    thetas : ndarray, shape (steps + 1,)
+        theta(t_q) / Ntilde.
+    mu : ndarray, shape (N,)
+        The initial thresholds mu_s.
+    batches : iterator of ndarray, each of shape (scene.batch,)
+        The replacement thresholds, used one per slip, in order. Methods
+        outside the solver (:mod:`slidernet.dynamics`,
+        :mod:`slidernet.speed_error`) read them to run the same realization.
+    """
+    thetas = draw_thetas(scene, rngs["driver"]) / scene.network.Ntilde
+    dist = scene.distribution
+    mu = dist.sample(rngs["thresholds"], scene.network.n_nodes).astype(np.float64)
+
+    def batches() -> Iterator[np.ndarray]:
+        while True:
+            yield dist.sample(rngs["thresholds"], scene.batch)
+
+    return thetas, mu, batches()
 
 
 def _refill(buf: np.ndarray, pos: int, draw: Callable[[int], np.ndarray], batch: int) -> np.ndarray:
@@ -285,11 +331,9 @@ class Realization:
     def __init__(self, scene: Scene, seed_seq: np.random.SeedSequence) -> None:
         self.scene = scene
         self.rngs = realization_streams(seed_seq)
-        net = scene.network
-        self.thetas = draw_thetas(scene, self.rngs["driver"]) / net.Ntilde
+        self.thetas, self.mu, self._mu_batches = horizontal_draws(scene, self.rngs)
+        self.mu_buf = next(self._mu_batches)
         dist = scene.distribution
-        self.mu = dist.sample(self.rngs["thresholds"], net.n_nodes).astype(np.float64)
-        self.mu_buf = dist.sample(self.rngs["thresholds"], scene.batch)
         if scene.tilt_at is not None:
             self.tmu = dist.sample(self.rngs["tilt"], scene.batch)
             self.tu = self.rngs["tilt"].random(scene.batch)
@@ -523,11 +567,10 @@ class Realization:
         sc = self.scene
         # The kernel stops at the end of the array it is given.
         thetas = self.thetas[: to_step + 1]
-        dist = sc.distribution
         ist = self.ist
 
         def draw_mu(size: int) -> np.ndarray:
-            return dist.sample(self.rngs["thresholds"], size)
+            return next(self._mu_batches)  # size is always sc.batch
 
         while True:
             status = self._call_kernel(thetas)
