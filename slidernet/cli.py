@@ -2,6 +2,8 @@
 
 ``slidernet run CONFIG.toml --out DIR``   writes DIR/result.nc
 ``slidernet paper [--quick] --out DIR``   reproduces the paper's four figures
+``slidernet bench speed-error [--quick] --out DIR``
+                                          speed against error of the methods (DIR/speed_error.csv, .png)
 ``slidernet plugins``                     lists the registered plugins, where they come from
 ``slidernet units --material steel --size 0.1 --delta-T 0.01``
                                           Ntilde, sigma_theta and tau_th of a physical setup
@@ -40,6 +42,18 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--out", type=Path, required=True, help="output directory")
     pp.add_argument("--quick", action="store_true", help="small preset (under 2 minutes)")
 
+    b = sub.add_parser("bench", help="measurements of slidernet itself")
+    bsub = b.add_subparsers(dest="bench", required=True)
+    se = bsub.add_parser(
+        "speed-error", help="speed against error of the event-driven solver and its alternatives",
+        description="Runs the event-driven solver, a fixed-step theta sweep, the full dynamics and the 2D "
+                    "straight-line slip on the same realizations and writes DIR/speed_error.csv "
+                    "(method,setting,seconds,error,...) and DIR/speed_error.png.",
+    )
+    se.add_argument("--out", type=Path, required=True, help="output directory")
+    se.add_argument("--quick", action="store_true", help="small preset (under 3 minutes)")
+    se.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
     sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
 
     from slidernet.units import MATERIALS
@@ -77,6 +91,15 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     from slidernet.paper import reproduce
 
     files = reproduce(args.out, quick=args.quick, progress=True)
+    for name, path in files.items():
+        print(f"{name}: {path}")
+    return 0
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from slidernet.speed_error import speed_error
+
+    files = speed_error(args.out, quick=args.quick, progress=not args.no_progress)
     for name, path in files.items():
         print(f"{name}: {path}")
     return 0
@@ -127,7 +150,8 @@ def _cmd_units(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``slidernet`` command; returns the exit status."""
     args = _parser().parse_args(argv)
-    commands = {"run": _cmd_run, "paper": _cmd_paper, "plugins": _cmd_plugins, "units": _cmd_units}
+    commands = {"run": _cmd_run, "paper": _cmd_paper, "bench": _cmd_bench, "plugins": _cmd_plugins,
+                "units": _cmd_units}
     try:
         return commands[args.command](args)
     except SlidernetError as exc:
