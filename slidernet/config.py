@@ -254,6 +254,40 @@ class SolverConfig(_Strict):
     max_events: Annotated[int, Field(ge=1)] = 10_000_000
 
 
+_SCHEDULER_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
+
+
+class ExecutionConfig(_Strict):
+    """Where and how the realizations run; never changes a result.
+
+    ``workers`` local processes run the realizations (None: every core this
+    process may use); ``scheduler`` (``"tcp://host:port"``) sends them to a
+    Dask distributed cluster instead. ``checkpoint_every`` (seconds) is how
+    often a run with an output directory saves its work. Realization r is
+    always driven by child r of the seed and the ensemble is reduced in
+    realization order, so the same config gives the same bits on 1 worker,
+    N workers or a cluster; this table is kept out of the identity of a run
+    (a run may resume with other workers).
+    """
+
+    workers: Annotated[int, Field(ge=1)] | None = None
+    scheduler: str | None = None
+    checkpoint_every: Annotated[float, Field(gt=0)] = 60.0
+
+    @field_validator("scheduler")
+    @classmethod
+    def _scheduler_address(cls, value: str | None) -> str | None:
+        if value is None:
+            return value
+        scheme, sep, rest = value.partition("://")
+        if not sep or scheme not in _SCHEDULER_SCHEMES or not rest:
+            raise ValueError(
+                f"must be a Dask scheduler address such as 'tcp://host:8786' (schemes: "
+                f"{', '.join(_SCHEDULER_SCHEMES)}); got {value!r}"
+            )
+        return value
+
+
 class Config(_Strict):
     """A full run: what to simulate, for how long, and what to record.
 
@@ -282,6 +316,7 @@ class Config(_Strict):
     friction: FrictionConfig
     driver: PluginSpec
     solver: SolverConfig = Field(default_factory=SolverConfig)
+    execution: ExecutionConfig = Field(default_factory=ExecutionConfig)
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)

@@ -15,6 +15,8 @@ realizations as independent clusters of correlated samples.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
+
 import numpy as np
 import xarray as xr
 
@@ -29,15 +31,15 @@ ATTRS = {
 }
 
 
-def _sem(x: np.ndarray) -> np.ndarray:
-    """Standard error over axis 0; NaN with a single realization (undefined)."""
-    R = x.shape[0]
-    if R < 2:
-        return np.full(x.shape[1:], np.nan)
-    return x.std(axis=0, ddof=1) / np.sqrt(R)
+Record = dict[str, np.ndarray]
+Variables = dict[str, tuple[tuple[str, ...], np.ndarray, dict[str, str]]]
+
+CHUNK = 1024
+"""Realizations per reduction chunk. Fixed, so that the ensemble statistics are
+summed in the same order whatever the number of workers or checkpoints."""
 
 
-def _network_variables(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> None:
+def _network_variables(ds: Variables, records: list[Record], first_realization: int) -> None:
     """Variables that only network kernels record (MODEL.md: networks add their own)."""
     first = records[0]
     per_t = {
@@ -54,14 +56,13 @@ def _network_variables(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> 
         ds["avalanche_count"] = (("realization", "avalanche_size"), counts, {
             "long_name": "number of avalanches (driving slip + triggered slips) per size bin "
                          "[s, 2 s), s = avalanche_size", "units": "1"})
-        ds.coords["avalanche_size"] = 2 ** np.arange(counts.shape[1], dtype=np.int64)
     if "node_slips" in first:
         ds["node_slips"] = (("realization", "node"), np.stack([r["node_slips"] for r in records]),
                             {"long_name": "number of slips of each node", "units": "1"})
         ds["mu_s"] = (("realization", "node"), np.stack([r["mu_s"] for r in records]),
                       {"long_name": "static threshold of each node at the end", "units": "1"})
     if "events" in first:
-        _event_catalogue(ds, records)
+        _event_catalogue(ds, records, first_realization)
 
 
 EVENT_ATTRS = {
@@ -73,13 +74,13 @@ EVENT_ATTRS = {
 }
 
 
-def _event_catalogue(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> None:
+def _event_catalogue(ds: Variables, records: list[Record], first_realization: int) -> None:
     """The slips of every realization, one after the other, along dim ``event``."""
     events = [r["events"] for r in records]
     sizes = [e["node"].size for e in events]
-    ds["event_realization"] = ("event", np.repeat(np.arange(len(records)), sizes),
+    ds["event_realization"] = ("event", np.repeat(np.arange(len(records)) + first_realization, sizes),
                                {"long_name": "realization of the slip", "units": "1"})
-    two_d = "y_G" in ds
+    two_d = "y_G" in records[0]
     for name, (long_name, units) in EVENT_ATTRS.items():
         if name == "dy" and not two_d:
             continue
@@ -90,17 +91,183 @@ def _event_catalogue(ds: xr.Dataset, records: list[dict[str, np.ndarray]]) -> No
                               "units": "1"})
 
 
-def assemble(
-    records: list[dict[str, np.ndarray]],
-    t: np.ndarray,
-    observables: list[str],
-    attrs: dict[str, str | int | float],
-) -> xr.Dataset:
-    """Stack the realizations' records into the result dataset.
+def realization_variables(records: list[Record], observables: list[str], first_realization: int = 0) -> Variables:
+    """The per-realization variables of consecutive realizations, stacked.
 
     Parameters
     ----------
     records : list of dict
+        Realizations ``first_realization, first_realization + 1, ...``, as
+        returned by :func:`slidernet.solver.simulate`.
+    observables : list of str
+        The requested observables.
+    first_realization : int
+        Index of ``records[0]``.
+
+    Returns
+    -------
+    dict
+        name -> (dims, data, attrs), dims starting with ``realization`` (or
+        ``event`` for the event catalogue).
+    """
+    out: Variables = {}
+    for name in ("n", "mu_max", "x_G", "n_records"):
+        if name in observables:
+            out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
+    _network_variables(out, records, first_realization)
+    return out
+
+
+def _undefined_sem(shape: tuple[int, ...]) -> np.ndarray:
+    return np.full(shape, np.nan)
+
+
+class EnsembleStats:
+    """Ensemble statistics reduced on the fly, chunk by chunk, in realization order.
+
+    Memory does not grow with the number of realizations. Feed
+    :meth:`add` consecutive chunks of :data:`CHUNK` realizations (the last one
+    may be shorter), always cut at the same places, so that the sums are the
+    same bits however the realizations were computed. Means are chunk sums
+    added in order; variances combine per-chunk two-pass moments (Chan et
+    al.'s pairwise update), which loses no digits to cancellation.
+
+    Parameters
+    ----------
+    observables : list of str
+        The requested observables.
+    steps : int
+        The last recorded time, for the rate ``r = n(steps) / steps``.
+    """
+
+    MOMENTS = ("n", "mu_max", "x_G", "n_records")
+
+    def __init__(self, observables: list[str], steps: int) -> None:
+        self.observables = list(observables)
+        self.steps = steps
+        self.R = 0
+        self._moments: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # name -> (mean, M2)
+        self._f: dict[str, np.ndarray] = {}
+
+    def _merge(self, name: str, x: np.ndarray) -> None:
+        """Fold the chunk ``x`` (B, ...) into the running (mean, M2) of ``name``."""
+        B = x.shape[0]
+        m_b = x.sum(axis=0) / B
+        m2_b = ((x - m_b) ** 2).sum(axis=0)
+        if name not in self._moments:
+            self._moments[name] = (m_b, m2_b)
+            return
+        mean, m2 = self._moments[name]
+        n_a = self.R
+        n = n_a + B
+        delta = m_b - mean
+        self._moments[name] = (mean + delta * (B / n), m2 + m2_b + delta**2 * (n_a * B / n))
+
+    def add(self, records: list[Record]) -> None:
+        """Fold the next chunk of consecutive realizations in."""
+        for name in self.MOMENTS:
+            if name in self.observables:
+                x = np.stack([r[name] for r in records]).astype(float)
+                self._merge(name, x)
+                if name == "x_G":
+                    self._merge("x_G2", x**2)
+        if "n" in self.observables and self.steps > 0:
+            self._merge("r", np.array([[r["n"][-1] / self.steps] for r in records]))
+        if "mu_eff" in self.observables:
+            fsum = np.stack([r["f_sum"] for r in records])
+            count = np.stack([r["f_count"] for r in records]).astype(float)
+            if not self._f:
+                # Shift for the sums of squares: the first chunk's pooled value,
+                # close to the final one, so that no digits cancel.
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    shift = fsum.sum(axis=0) / count.sum(axis=0)
+                self._f = {"shift": np.nan_to_num(shift), "f": 0.0, "c": 0.0, "gg": 0.0, "gc": 0.0, "cc": 0.0}
+            g = fsum - self._f["shift"] * count
+            f = self._f
+            f["f"] = f["f"] + fsum.sum(axis=0)
+            f["c"] = f["c"] + count.sum(axis=0)
+            f["gg"] = f["gg"] + (g * g).sum(axis=0)
+            f["gc"] = f["gc"] + (g * count).sum(axis=0)
+            f["cc"] = f["cc"] + (count * count).sum(axis=0)
+        self.R += len(records)
+
+    def _mean_sem(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        mean, m2 = self._moments[name]
+        if self.R < 2:  # undefined with a single realization
+            return mean, _undefined_sem(np.shape(mean))
+        return mean, np.sqrt(m2 / (self.R - 1)) / np.sqrt(self.R)
+
+    def finish(self) -> Variables:
+        """The statistics: ``<name>_mean``, ``<name>_sem``, ``x_G2_*``, ``r_*``, ``mu_eff*``."""
+        out: Variables = {}
+        for name in self.MOMENTS:
+            if name not in self.observables:
+                continue
+            units = ATTRS[name]["units"]
+            mean, sem = self._mean_sem(name)
+            out[f"{name}_mean"] = ("t", mean, {"long_name": f"ensemble mean of {name}", "units": units})
+            out[f"{name}_sem"] = ("t", sem, {"long_name": f"standard error of {name}_mean", "units": units})
+            if name == "x_G":
+                mean, sem = self._mean_sem("x_G2")
+                out["x_G2_mean"] = ("t", mean, {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
+                out["x_G2_sem"] = ("t", sem, {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+        if "r" in self._moments:
+            mean, sem = self._mean_sem("r")
+            out["r_mean"] = ((), mean[0], {"long_name": "mean rearrangements per tau_th", "units": "1"})
+            out["r_sem"] = ((), sem[0], {"long_name": "standard error of r_mean", "units": "1"})
+        if self._f:
+            f, R = self._f, self.R
+            total = f["c"]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                mu_eff = f["f"] / total
+                # Ratio estimator, realizations as independent clusters:
+                # sum_r (f_r - mu_eff c_r)^2, expanded about the shift.
+                d = mu_eff - f["shift"]
+                resid2 = np.maximum(f["gg"] - 2 * d * f["gc"] + d * d * f["cc"], 0.0)
+                sem = np.sqrt(resid2 / (R * (R - 1))) / (total / R) if R > 1 else _undefined_sem(total.shape)
+            out["mu_eff"] = ("t", mu_eff, ATTRS["mu_eff"])
+            out["mu_eff_sem"] = ("t", np.where(total > 0, sem, np.nan),
+                                 {"long_name": "standard error of mu_eff", "units": "1"})
+            out["mu_eff_count"] = ("t", total.astype(np.int64),
+                                   {"long_name": "number of tilt tests pooled into mu_eff", "units": "1"})
+        return out
+
+
+def chunks(records: Iterable[Record], size: int = CHUNK) -> Iterator[list[Record]]:
+    """Consecutive lists of ``size`` records (the last one shorter)."""
+    chunk: list[Record] = []
+    for rec in records:
+        chunk.append(rec)
+        if len(chunk) == size:
+            yield chunk
+            chunk = []
+    if chunk:
+        yield chunk
+
+
+def coordinates(t: np.ndarray, R: int, first: Record) -> dict[str, tuple]:
+    """The coordinates of the result: ``realization``, ``t`` and, for networks, ``avalanche_size``."""
+    coords: dict[str, tuple] = {
+        "realization": ("realization", np.arange(R, dtype=np.int64)),
+        "t": ("t", np.asarray(t, dtype=np.int64), {"long_name": "time", "units": "tau_th"}),
+    }
+    if "avalanche_count" in first:
+        bins = first["avalanche_count"].size
+        coords["avalanche_size"] = ("avalanche_size", 2 ** np.arange(bins, dtype=np.int64))
+    return coords
+
+
+def assemble(
+    records: Iterable[Record],
+    t: np.ndarray,
+    observables: list[str],
+    attrs: dict[str, str | int | float],
+) -> xr.Dataset:
+    """Stack the realizations' records into the result dataset, in memory.
+
+    Parameters
+    ----------
+    records : iterable of dict
         One dict per realization, in realization order, as returned by
         :func:`slidernet.solver.simulate`.
     t : ndarray of int, shape (T,)
@@ -114,45 +281,23 @@ def assemble(
     -------
     xarray.Dataset
         Coordinates ``realization`` and ``t``; see the module docstring.
+        :func:`slidernet.io.write_result_stream` writes the same variables,
+        chunk by chunk, to a file.
     """
-    R = len(records)
-    coords = {"realization": np.arange(R), "t": np.asarray(t, dtype=np.int64)}
-    ds = xr.Dataset(coords=coords, attrs=dict(attrs))
-    ds["t"].attrs.update(long_name="time", units="tau_th")
-    for name in ("n", "mu_max", "x_G", "n_records"):
-        if name not in observables:
-            continue
-        data = np.stack([r[name] for r in records])
-        ds[name] = (("realization", "t"), data, ATTRS[name])
-        ds[f"{name}_mean"] = ("t", data.mean(axis=0),
-                              {"long_name": f"ensemble mean of {name}", "units": ATTRS[name]["units"]})
-        ds[f"{name}_sem"] = ("t", _sem(data), {"long_name": f"standard error of {name}_mean",
-                                               "units": ATTRS[name]["units"]})
-        if name == "x_G":
-            x2 = data**2
-            ds["x_G2_mean"] = ("t", x2.mean(axis=0),
-                               {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
-            ds["x_G2_sem"] = ("t", _sem(x2),
-                              {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
-    _network_variables(ds, records)
-    if "n" in observables and ds.sizes["t"] > 1:
-        steps = int(t[-1])
-        r = np.array([rec["n"][-1] / steps for rec in records])
-        ds["r_mean"] = ((), r.mean(), {"long_name": "mean rearrangements per tau_th", "units": "1"})
-        ds["r_sem"] = ((), _sem(r[:, None])[0], {"long_name": "standard error of r_mean", "units": "1"})
-    if "mu_eff" in observables:
-        fsum = np.stack([r["f_sum"] for r in records])
-        count = np.stack([r["f_count"] for r in records]).astype(float)
-        total = count.sum(axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mu_eff = fsum.sum(axis=0) / total
-            # Ratio estimator: realizations are independent clusters.
-            cbar = total / R
-            resid = fsum - mu_eff[None, :] * count
-            sem = np.sqrt((resid**2).sum(axis=0) / (R * (R - 1))) / cbar if R > 1 else np.nan * total
-        ds["mu_eff"] = ("t", mu_eff, ATTRS["mu_eff"])
-        ds["mu_eff_sem"] = ("t", np.where(total > 0, sem, np.nan),
-                            {"long_name": "standard error of mu_eff", "units": "1"})
-        ds["mu_eff_count"] = ("t", total.astype(np.int64),
-                              {"long_name": "number of tilt tests pooled into mu_eff", "units": "1"})
+    stats = EnsembleStats(observables, int(t[-1]))
+    parts: list[Variables] = []
+    R = 0
+    first: Record | None = None
+    for chunk in chunks(records):
+        first = first or chunk[0]
+        parts.append(realization_variables(chunk, observables, R))
+        stats.add(chunk)
+        R += len(chunk)
+    if first is None:
+        raise ValueError("assemble needs at least one realization")
+    data = {name: (dims, np.concatenate([p[name][1] for p in parts]), a)
+            for name, (dims, _, a) in parts[0].items()}
+    ds = xr.Dataset(data, coords=coordinates(t, R, first), attrs=dict(attrs))
+    for name, var in stats.finish().items():
+        ds[name] = var
     return ds
