@@ -1,6 +1,9 @@
 """Command-line interface: a thin layer over the library.
 
-``slidernet run CONFIG.toml --out DIR``   writes DIR/result.nc
+``slidernet run CONFIG.toml --out DIR [--workers N | --scheduler tcp://...] [--resume]``
+                                          writes DIR/result.nc, checkpointing under DIR/checkpoint
+``slidernet sweep CONFIG.toml --set KEY=V1,V2 ... --out DIR``
+                                          a grid of runs, one dataset with the swept dimensions
 ``slidernet paper [--quick] --out DIR``   reproduces the paper's four figures
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
@@ -37,6 +40,19 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("config", type=Path, help="TOML configuration (see MODEL.md section 5)")
     r.add_argument("--out", type=Path, required=True, help="output directory")
     r.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _execution_flags(r)
+
+    sw = sub.add_parser(
+        "sweep", help="run a grid of parameters; write DIR/result.nc with the swept parameters as dimensions",
+        description="Each --set KEY=V1,V2,... adds a dimension; the grid is their product. Every point uses "
+                    "the configuration's seed, so a point equals the plain run of its configuration.",
+    )
+    sw.add_argument("config", type=Path, help="TOML configuration (see MODEL.md section 5)")
+    sw.add_argument("--set", dest="sets", action="append", required=True, metavar="KEY=V1,V2,...",
+                    help="a dotted configuration key and its values, e.g. driver.sigma_theta=1e-7,1e-6")
+    sw.add_argument("--out", type=Path, required=True, help="output directory")
+    sw.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _execution_flags(sw)
 
     pp = sub.add_parser("paper", help="reproduce the four figures of Geminard & Bertin (2010)")
     pp.add_argument("--out", type=Path, required=True, help="output directory")
@@ -75,15 +91,38 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _execution_flags(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--workers", type=int, help="local worker processes (default: execution.workers, "
+                                               "else every core)")
+    p.add_argument("--scheduler", help="a Dask scheduler address, e.g. tcp://host:8786 (default: "
+                                       "execution.scheduler)")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the interrupted run in --out (same configuration), to the same bits")
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
-    from slidernet.io import write_netcdf
     from slidernet.runner import run
 
     cfg = load_config(args.config)  # validate before any work or any file
-    ds = run(cfg, progress=not args.no_progress)
-    path = write_netcdf(ds, args.out / "result.nc")
-    print(f"wrote {path} (seed {ds.attrs['seed']}, kernel {ds.attrs['kernel']})")
+    with run(cfg, progress=not args.no_progress, out=args.out, resume=args.resume, workers=args.workers,
+             scheduler=args.scheduler) as ds:
+        print(f"wrote {args.out / 'result.nc'} (seed {ds.attrs['seed']}, kernel {ds.attrs['kernel']})")
+    return 0
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from slidernet.sweep import parse_set, sweep
+
+    grid = dict(parse_set(text) for text in args.sets)
+    if len(grid) != len(args.sets):
+        from slidernet.errors import ConfigError
+
+        raise ConfigError("A key is given twice with --set; give each key once, with all its values.")
+    ds = sweep(args.config, grid, progress=not args.no_progress, out=args.out, resume=args.resume,
+               workers=args.workers, scheduler=args.scheduler)
+    dims = ", ".join(f"{d} = {ds.sizes[d]}" for d in ds.dims if d not in ("realization", "t"))
+    print(f"wrote {args.out / 'result.nc'} ({dims})")
     return 0
 
 
@@ -150,15 +189,17 @@ def _cmd_units(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``slidernet`` command; returns the exit status."""
     args = _parser().parse_args(argv)
-    commands = {"run": _cmd_run, "paper": _cmd_paper, "bench": _cmd_bench, "plugins": _cmd_plugins,
+    commands = {"run": _cmd_run, "paper": _cmd_paper, "bench": _cmd_bench, "sweep": _cmd_sweep,
+                "plugins": _cmd_plugins,
                 "units": _cmd_units}
     try:
         return commands[args.command](args)
     except SlidernetError as exc:
         print(f"slidernet: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("slidernet: interrupted; no partial result was written.", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(f"slidernet: {exc}" if str(exc) else "slidernet: interrupted; no partial result was written.",
+              file=sys.stderr)
         return 130
 
 

@@ -277,15 +277,21 @@ class ExecutionConfig(_Strict):
     @field_validator("scheduler")
     @classmethod
     def _scheduler_address(cls, value: str | None) -> str | None:
-        if value is None:
-            return value
-        scheme, sep, rest = value.partition("://")
-        if not sep or scheme not in _SCHEDULER_SCHEMES or not rest:
-            raise ValueError(
-                f"must be a Dask scheduler address such as 'tcp://host:8786' (schemes: "
-                f"{', '.join(_SCHEDULER_SCHEMES)}); got {value!r}"
-            )
+        if value is not None and not is_scheduler_address(value):
+            raise ValueError(f"must be {SCHEDULER_REQUIREMENT}; got {value!r}")
         return value
+
+
+SCHEDULER_REQUIREMENT = (f"a Dask scheduler address such as 'tcp://host:8786' (schemes: "
+                         f"{', '.join(_SCHEDULER_SCHEMES)})")
+
+
+def is_scheduler_address(value: object) -> bool:
+    """Whether ``value`` reads as a Dask scheduler address ``scheme://host[:port]``."""
+    if not isinstance(value, str):
+        return False
+    scheme, sep, rest = value.partition("://")
+    return bool(sep) and scheme in _SCHEDULER_SCHEMES and bool(rest)
 
 
 class Config(_Strict):

@@ -31,6 +31,14 @@ class TiltTestError(SlidernetError, RuntimeError):
     """The virtual tilt test did not reach a sliding state within its iteration cap."""
 
 
+class CheckpointError(SlidernetError, ValueError):
+    """A checkpoint file is unreadable, or belongs to another run or scene."""
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C after saving its work; the message says how to resume it."""
+
+
 def param_error(param: str, owner: str, requirement: str, got: object) -> ConfigError:
     """Build the standard message for a bad parameter value.
 

@@ -10,10 +10,11 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
 
@@ -50,6 +51,77 @@ def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
     with atomic_output(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")
     return Path(path)
+
+
+def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray, R: int,
+                        observables: list[str], attrs: dict[str, str]) -> Path:
+    """Write a result to netCDF chunk by chunk, atomically; memory does not grow with R.
+
+    The same variables and bits as :func:`slidernet.observables.assemble`
+    followed by :func:`write_netcdf`: the per-realization variables go to the
+    file one chunk of :data:`slidernet.observables.CHUNK` realizations at a
+    time (stored in chunks of that many realizations), the ensemble
+    statistics are reduced on the fly in the same chunks.
+
+    Parameters
+    ----------
+    records : iterable of dict
+        The R realizations' records, in realization order.
+    path : path
+        The netCDF file to write.
+    t : ndarray of int, shape (T,)
+        Recorded times.
+    R : int
+        Number of realizations.
+    observables : list of str
+        The requested observables.
+    attrs : dict
+        Global attributes.
+    """
+    import netCDF4
+
+    from slidernet.observables import CHUNK, EnsembleStats, chunks, coordinates, realization_variables
+
+    def create(nc, name: str, dims: str | tuple[str, ...], data: np.ndarray, var_attrs: dict) -> netCDF4.Variable:
+        dims = (dims,) if isinstance(dims, str) else tuple(dims)
+        for i, d in enumerate(dims):  # dimensions without a coordinate (node)
+            if d not in nc.dimensions:
+                nc.createDimension(d, data.shape[i])
+        fixed = {"realization": min(CHUNK, R), "event": 1 << 16}
+        sizes = [fixed.get(d) or max(1, len(nc.dimensions[d])) for d in dims]
+        var = nc.createVariable(name, data.dtype, dims, fill_value=False, chunksizes=sizes or None,
+                                contiguous=not dims)
+        var.setncatts(var_attrs)
+        return var
+
+    path = Path(path)
+    with atomic_output(path) as tmp, netCDF4.Dataset(tmp, "w", format="NETCDF4") as nc:
+        stats = EnsembleStats(observables, int(t[-1]))
+        r0 = 0
+        for chunk in chunks(records):
+            if r0 == 0:
+                for name, (dim, data, *rest) in coordinates(t, R, chunk[0]).items():
+                    nc.createDimension(dim, data.size)
+                    create(nc, name, (dim,), data, rest[0] if rest else {})[:] = data
+                if "events" in chunk[0]:
+                    nc.createDimension("event", None)
+            variables = realization_variables(chunk, observables, r0)
+            offset = len(nc.dimensions["event"]) if "event" in nc.dimensions else 0
+            for name, (dims, data, var_attrs) in variables.items():
+                var = nc.variables[name] if name in nc.variables else create(nc, name, dims, data, var_attrs)
+                if dims in ("event", ("event",)):
+                    var[offset:offset + data.shape[0]] = data
+                else:
+                    var[r0:r0 + data.shape[0]] = data
+            stats.add(chunk)
+            r0 += len(chunk)
+        if r0 != R:
+            raise ValueError(f"write_result_stream got {r0} realizations, expected {R}")
+        for name, (dims, data, var_attrs) in stats.finish().items():
+            data = np.asarray(data)
+            create(nc, name, dims, data, var_attrs)[...] = data
+        nc.setncatts(attrs)
+    return path
 
 
 def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:

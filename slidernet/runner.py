@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -12,19 +13,19 @@ import xarray as xr
 from tqdm.auto import tqdm
 
 import slidernet
-from slidernet.config import Config, load_config
-from slidernet.observables import assemble
-from slidernet.solver import Scene, simulate
+from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
+from slidernet.errors import RunInterrupted, param_error
+from slidernet.execution import available_cores, execute, scene_of
+from slidernet.io import write_result_stream
+from slidernet.observables import CHUNK, assemble
+from slidernet.store import RunStore
 
 
 def resolve_seed(cfg: Config) -> Config:
     """A copy of ``cfg`` whose seed is set: fresh OS entropy when it was None."""
     if cfg.seed is not None:
         return cfg
-    resolved = cfg.model_copy(update={"seed": int(np.random.SeedSequence().entropy)})
-    resolved._distribution = cfg._distribution
-    resolved._driver = cfg._driver
-    return resolved
+    return _with_seed(cfg, int(np.random.SeedSequence().entropy))
 
 
 def realization_seeds(seed: int, realizations: int) -> list[np.random.SeedSequence]:
@@ -32,10 +33,34 @@ def realization_seeds(seed: int, realizations: int) -> list[np.random.SeedSequen
     return np.random.SeedSequence(seed).spawn(realizations)
 
 
+def identity(requested: Config, resolved: Config) -> dict[str, Any]:
+    """What a checkpoint must match to be resumed: the config without its execution table, the seed, R."""
+    config = requested.model_dump(mode="json", exclude={"execution"})
+    return {"config": config, "seed": resolved.seed, "realizations": resolved.realizations,
+            "slidernet_version": slidernet.__version__}
+
+
+def _attrs(cfg: Config, kernel: str, workers: int, scheduler: str | None) -> dict[str, str]:
+    return {
+        "config": json.dumps(cfg.model_dump(mode="json", exclude={"execution"}), sort_keys=True),
+        "execution": json.dumps({"workers": workers, "scheduler": scheduler}),
+        "slidernet_version": slidernet.__version__,
+        "seed": str(cfg.seed),
+        "kernel": kernel,
+        "Conventions": "CF-1.8",
+        "title": "slidernet result",
+    }
+
+
 def run(
     config: Config | Mapping[str, Any] | str | Path,
     progress: bool | None = False,
     on_realization: Callable[[int], None] | None = None,
+    *,
+    out: str | Path | None = None,
+    resume: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
 ) -> xr.Dataset:
     """Simulate an ensemble of realizations and return the result dataset.
 
@@ -44,10 +69,27 @@ def run(
     config : Config, dict or path
         The run configuration (MODEL.md section 5); a path is read as TOML.
     progress : bool or None
-        Show a progress bar over realizations (None: only on a terminal).
+        Show a progress bar over realizations, all workers together (None:
+        only on a terminal).
     on_realization : callable, optional
         Called with the index of each realization once it is done (for
         callers that drive their own progress display).
+    out : path, optional
+        Output directory: the result goes to ``out/result.nc`` (written
+        chunk by chunk, so memory does not grow with the number of
+        realizations) and the run checkpoints its work under
+        ``out/checkpoint/`` every ``execution.checkpoint_every`` seconds and
+        on Ctrl-C. The returned dataset is then opened lazily from the file.
+    resume : bool
+        Continue the interrupted run in ``out`` (same configuration; the
+        execution table may differ). The result is the bits of an
+        uninterrupted run.
+    workers : int, optional
+        Local worker processes; overrides ``execution.workers`` (default:
+        every core).
+    scheduler : str, optional
+        Dask scheduler address (``"tcp://host:port"``); overrides
+        ``execution.scheduler``.
 
     Returns
     -------
@@ -55,7 +97,13 @@ def run(
         Variables ``n``, ``mu_max``, ``x_G`` (realization, t) and ``mu_eff``
         (t) as requested, with ensemble means and standard errors; attributes
         ``config`` (the resolved configuration as JSON), ``slidernet_version``,
-        ``seed`` and ``kernel``.
+        ``seed``, ``kernel`` and ``execution``.
+
+    Raises
+    ------
+    RunInterrupted
+        On Ctrl-C, after the finished realizations (and, inside a realization,
+        its state) are saved under ``out``; its message says how to resume.
 
     Examples
     --------
@@ -69,21 +117,72 @@ def run(
     >>> bool((ds["mu_max"].diff("t") >= 0).all())
     True
     """
-    cfg = resolve_seed(load_config(config))
-    scene = Scene.from_config(cfg)
-    seeds = realization_seeds(cfg.seed, cfg.realizations)
-    records = []
-    bar = tqdm(seeds, desc="realizations", disable=None if progress is None else not progress)
-    for r, ss in enumerate(bar):
-        records.append(simulate(scene, ss))
-        if on_realization is not None:
-            on_realization(r)
-    attrs = {
-        "config": json.dumps(cfg.model_dump(mode="json"), sort_keys=True),
-        "slidernet_version": slidernet.__version__,
-        "seed": str(cfg.seed),
-        "kernel": scene.kernel,
-        "Conventions": "CF-1.8",
-        "title": "slidernet result",
-    }
-    return assemble(records, scene.rec_times, list(cfg.observables), attrs)
+    requested = load_config(config)
+    cfg = resolve_seed(requested)
+    ex = cfg.execution
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise param_error("workers", "run", "an integer >= 1", workers)
+    if scheduler is not None and not is_scheduler_address(scheduler):
+        raise param_error("scheduler", "run", SCHEDULER_REQUIREMENT, scheduler)
+    workers = workers or ex.workers or available_cores()
+    scheduler = scheduler or ex.scheduler
+    R = cfg.realizations
+    store = None
+    if out is not None:
+        store = RunStore(out, identity(requested, cfg), resume)
+        seed = store.open()
+        if seed != cfg.seed:  # a resumed run whose config left the seed to fresh entropy
+            cfg = _with_seed(cfg, seed)
+    config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
+    scene = scene_of(config_json)  # validates the scene; forked workers inherit it
+    done = store.done() if store is not None else {}
+    pending = [r for r in range(R) if r not in done]
+    meta = {"config": json.dumps(identity(requested, cfg), sort_keys=True)}
+
+    def args(r: int) -> tuple:
+        partial = None if store is None else str(store.partial(r))
+        return config_json, cfg.seed, r, partial, ex.checkpoint_every, meta
+
+    attrs = _attrs(cfg, scene.kernel, workers, scheduler)
+    bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
+               disable=None if progress is None else not progress)
+    records: dict[int, dict] = {}
+    last_flush = time.monotonic()
+    try:
+        for r, rec in execute(pending, args, workers, scheduler):
+            if store is None:
+                records[r] = rec
+            else:
+                store.add(r, rec)
+                if time.monotonic() - last_flush >= ex.checkpoint_every or len(store._buffer) >= CHUNK:
+                    store.flush()
+                    last_flush = time.monotonic()
+            bar.update()
+            if on_realization is not None:
+                on_realization(r)
+    except KeyboardInterrupt:
+        if store is None:
+            raise
+        store.flush()
+        saved = len(store.done())
+        raise RunInterrupted(
+            f"interrupted: {saved} of {R} realizations are saved in {str(store.dir)!r} (and the state of "
+            f"those in progress); continue with `slidernet run CONFIG --out {str(out)!r} --resume` or "
+            f"slidernet.run(config, out=..., resume=True)."
+        ) from None
+    finally:
+        bar.close()
+    if store is None:
+        return assemble((records.pop(r) for r in range(R)), scene.rec_times, list(cfg.observables), attrs)
+    store.flush()
+    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.rec_times, R,
+                               list(cfg.observables), attrs)
+    store.remove()
+    return xr.open_dataset(path, engine="netcdf4")
+
+
+def _with_seed(cfg: Config, seed: int) -> Config:
+    resolved = cfg.model_copy(update={"seed": seed})
+    resolved._distribution = cfg._distribution
+    resolved._driver = cfg._driver
+    return resolved

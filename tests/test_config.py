@@ -161,9 +161,10 @@ def test_refused_before_any_work(key, value, clean_registries):
     with pytest.raises(ConfigError):
         slidernet.run(cfg)
     assert SpyDriver.calls == 0
-    # Sanity: the same config without the bad value does run the driver.
+    # Sanity: the same config without the bad value does run the driver (in
+    # this process, where the spy counts: one worker).
     good = make_config(steps=10, realizations=2, observables=["n"], **{"driver.name": "spy"})
-    slidernet.run(good)
+    slidernet.run(good, workers=1)
     assert SpyDriver.calls == 2
 
 

@@ -99,7 +99,7 @@ def test_progress_callback_does_not_change_the_result():
     cfg = _config(1e-6, 50, 3, seed=7, observables=("n", "mu_max", "x_G", "mu_eff"), points_per_decade=5)
     calls = []
     mine = slidernet.run(cfg, on_realization=calls.append)
-    assert calls == [0, 1, 2]
+    assert sorted(calls) == [0, 1, 2]  # in the order the workers finish
     xr.testing.assert_identical(mine, slidernet.run(cfg))
 
 

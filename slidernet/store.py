@@ -1,0 +1,208 @@
+"""The checkpoint folder of a run: what is done, kept so that a killed run loses (almost) nothing.
+
+Layout of ``DIR/checkpoint/`` (plain numeric files and JSON; no pickle)::
+
+    run.json                 what identifies the run: the configuration (without
+                             its execution table), the resolved seed, the
+                             number of realizations, the slidernet version
+    block-<first>-<k>.npz    finished realizations, written together: their
+                             indices, then every record stacked (ragged records,
+                             the event catalogue, concatenated with offsets)
+    partial-<r>.npz          a realization in progress (slidernet.checkpoint)
+
+Every file is written to a temporary name and renamed, so a kill at any time
+leaves either the old file or the new one. The set of finished realizations is
+read from the blocks themselves (not from a list that could disagree with
+them). Once ``result.nc`` is written the folder is removed.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from slidernet.errors import CheckpointError
+from slidernet.io import atomic_output
+
+Record = dict[str, Any]
+
+_BLOCK = re.compile(r"block-(\d+)-(\d+)\.npz")
+
+
+def _flat_diff(a: Any, b: Any, prefix: str = "") -> list[str]:
+    """Dotted keys where two JSON-like trees differ."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for key in sorted(set(a) | set(b)):
+            out += _flat_diff(a.get(key), b.get(key), f"{prefix}{key}.")
+        return out
+    return [] if a == b else [f"{prefix[:-1]} ({json.dumps(a)} in the checkpoint, {json.dumps(b)} now)"]
+
+
+class RunStore:
+    """The checkpoint folder ``out_dir / "checkpoint"`` of one run.
+
+    Parameters
+    ----------
+    out_dir : path
+        The run's output directory.
+    identity : dict
+        ``config`` (the configuration as JSON-ready dict, without ``execution``;
+        its ``seed`` as the user gave it), ``seed`` (resolved), ``realizations``
+        and ``slidernet_version``.
+    resume : bool
+        Continue the run found there. Without it, a folder that holds an
+        interrupted run is refused rather than overwritten.
+    """
+
+    def __init__(self, out_dir: str | Path, identity: dict[str, Any], resume: bool) -> None:
+        self.dir = Path(out_dir) / "checkpoint"
+        self.identity = dict(identity)
+        self.resume = resume
+        self._buffer: dict[int, Record] = {}
+
+    # -- opening ---------------------------------------------------------
+    def open(self) -> int:
+        """Create or check the folder; return the seed to use (the stored one on resume)."""
+        run_json = self.dir / "run.json"
+        if run_json.exists():
+            try:
+                stored = json.loads(run_json.read_text())
+            except (OSError, ValueError) as exc:
+                raise CheckpointError(f"The checkpoint {str(run_json)!r} cannot be read: {exc}") from None
+            done = len(self.done())
+            if not self.resume:
+                raise CheckpointError(
+                    f"{str(self.dir.parent)!r} holds an interrupted run ({done} of {stored.get('realizations')} "
+                    f"realizations done). Continue it with --resume (resume=True), or remove "
+                    f"{str(self.dir)!r} to start again."
+                )
+            diff = _flat_diff(stored["config"], self.identity["config"])
+            if stored.get("realizations") != self.identity["realizations"]:
+                diff.append(f"realizations ({stored.get('realizations')} in the checkpoint, "
+                            f"{self.identity['realizations']} now)")
+            if diff:
+                raise CheckpointError(
+                    "Cannot resume: the configuration differs from the checkpointed run's in "
+                    + "; ".join(diff) + ". Resume with the same configuration, or use another output directory."
+                )
+            if stored.get("slidernet_version") != self.identity["slidernet_version"]:
+                raise CheckpointError(
+                    f"Cannot resume: the checkpoint was written by slidernet {stored.get('slidernet_version')}, "
+                    f"this is {self.identity['slidernet_version']}; results would not be bit-identical."
+                )
+            self.identity["seed"] = stored["seed"]
+            return int(stored["seed"])
+        if self.resume:
+            raise CheckpointError(f"Nothing to resume in {str(self.dir.parent)!r}: it has no checkpoint folder.")
+        self.dir.mkdir(parents=True, exist_ok=True)
+        with atomic_output(run_json) as tmp:
+            tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
+        return int(self.identity["seed"])
+
+    # -- finished realizations -------------------------------------------
+    def _blocks(self) -> list[Path]:
+        if not self.dir.exists():
+            return []
+        return sorted((p for p in self.dir.iterdir() if _BLOCK.fullmatch(p.name)),
+                      key=lambda p: int(_BLOCK.fullmatch(p.name).group(1)))
+
+    def done(self) -> dict[int, tuple[Path, int]]:
+        """Finished realization -> (its block, its row in the block)."""
+        out: dict[int, tuple[Path, int]] = {}
+        for path in self._blocks():
+            try:
+                with np.load(path, allow_pickle=False) as z:
+                    idx = z["realization"]
+            except (OSError, ValueError, KeyError) as exc:
+                raise CheckpointError(f"The checkpoint block {str(path)!r} is damaged: {exc}") from None
+            for row, r in enumerate(idx.tolist()):
+                out[r] = (path, row)
+        return out
+
+    def add(self, r: int, record: Record) -> None:
+        """Hold a finished realization until the next :meth:`flush`."""
+        self._buffer[r] = record
+
+    def flush(self) -> None:
+        """Write the held realizations as one block, then drop their partial files."""
+        if not self._buffer:
+            return
+        rs = sorted(self._buffer)
+        arrays = _pack([self._buffer[r] for r in rs])
+        arrays["realization"] = np.array(rs, np.int64)
+        path = self.dir / f"block-{rs[0]:09d}-{len(rs)}.npz"
+        k = 0
+        while path.exists():  # the same first realization can recur after a resume
+            k += 1
+            path = self.dir / f"block-{rs[0]:09d}-{len(rs)}-{k}.npz"
+        with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+        for r in rs:
+            self.partial(r).unlink(missing_ok=True)
+        self._buffer.clear()
+
+    def partial(self, r: int) -> Path:
+        """Where realization ``r`` in progress is saved."""
+        return self.dir / f"partial-{r:09d}.npz"
+
+    def records(self, R: int) -> Iterator[Record]:
+        """Every realization's records, in realization order, reading one block at a time (or two)."""
+        where = self.done()
+        missing = [r for r in range(R) if r not in where]
+        if missing:
+            raise CheckpointError(f"{len(missing)} realizations are missing from {str(self.dir)!r}, "
+                                  f"e.g. {missing[:5]}")
+        cache: dict[Path, list[Record]] = {}
+        for r in range(R):
+            path, row = where[r]
+            if path not in cache:
+                if len(cache) >= 2:
+                    cache.pop(next(iter(cache)))
+                with np.load(path, allow_pickle=False) as z:
+                    cache[path] = _unpack({k: z[k] for k in z.files})
+            yield cache[path][row]
+
+    def remove(self) -> None:
+        """Delete the folder (the run's result is safely written)."""
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+# -- records <-> flat arrays ---------------------------------------------------
+def _pack(records: list[Record]) -> dict[str, np.ndarray]:
+    """Stack records into named arrays; dict-valued entries (ragged) are concatenated with offsets."""
+    out: dict[str, np.ndarray] = {}
+    for key, value in records[0].items():
+        if isinstance(value, dict):
+            sizes = [len(next(iter(rec[key].values()))) for rec in records]
+            out[f"{key}/offsets"] = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            for sub in value:
+                out[f"{key}/{sub}"] = np.concatenate([np.asarray(rec[key][sub]) for rec in records])
+        else:
+            out[key] = np.stack([np.asarray(rec[key]) for rec in records])
+    return out
+
+
+def _unpack(arrays: dict[str, np.ndarray]) -> list[Record]:
+    """Inverse of :func:`_pack`."""
+    B = arrays["realization"].size
+    records: list[Record] = [{} for _ in range(B)]
+    ragged = {k.split("/")[0] for k in arrays if "/" in k}
+    for key, value in arrays.items():
+        if key == "realization" or "/" in key:
+            continue
+        for b in range(B):
+            item = value[b]
+            records[b][key] = item.item() if item.ndim == 0 and value.dtype == bool else item
+    for key in ragged:
+        off = arrays[f"{key}/offsets"]
+        subs = [k.split("/", 1)[1] for k in arrays if k.startswith(f"{key}/") and not k.endswith("/offsets")]
+        for b in range(B):
+            records[b][key] = {s: arrays[f"{key}/{s}"][off[b]:off[b + 1]] for s in subs}
+    return records

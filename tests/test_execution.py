@@ -1,0 +1,245 @@
+"""Ensembles at scale: workers, a Dask cluster, checkpoints, resume, streamed results.
+
+The contract tested here: the same configuration gives the same bits on one
+worker, on N workers, on a Dask cluster, streamed to a file or kept in
+memory, and after any number of kills and resumes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import netCDF4
+import numpy as np
+import pytest
+import xarray as xr
+
+import slidernet
+from slidernet.config import tomllib
+from slidernet.errors import CheckpointError, ConfigError
+from slidernet.io import read_result, write_netcdf
+
+PAIR = {
+    "seed": 3, "realizations": 5, "steps": 400, "observables": ["n", "mu_max", "x_G", "mu_eff", "n_records"],
+    "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6},
+}
+LATTICE = {**PAIR, "steps": 30, "realizations": 3, "observables": ["n", "mu_max", "x_G", "mu_eff", "events"],
+           "network": {"kind": "triangular", "shape": [4, 5], "Ntilde": 1e-7},
+           "driver": {"name": "gaussian_steps", "sigma_theta": 2e-7}}
+SCENES = {"pair": PAIR, "lattice": LATTICE}
+
+
+def assert_same_bits(a: xr.Dataset, b: xr.Dataset) -> None:
+    """Every data variable and coordinate equal to the bit (NaN where the other has NaN); same config."""
+    assert set(a.variables) == set(b.variables)
+    for name in a.variables:
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+        assert a[name].dtype == b[name].dtype, name
+    assert json.loads(a.attrs["config"]) == json.loads(b.attrs["config"])
+
+
+@pytest.fixture(scope="module", params=list(SCENES), ids=list(SCENES))
+def reference(request):
+    """One worker, in memory: the reference bits of each scene."""
+    cfg = SCENES[request.param]
+    return cfg, slidernet.run(cfg, workers=1)
+
+
+def test_two_workers_give_the_same_bits(reference):
+    cfg, ref = reference
+    assert_same_bits(slidernet.run(cfg, workers=2), ref)
+
+
+def test_streamed_file_is_the_in_memory_result(reference, tmp_path):
+    cfg, ref = reference
+    with slidernet.run(cfg, workers=2, out=tmp_path) as ds:
+        assert_same_bits(ds.load(), ref)
+    write_netcdf(ref, tmp_path / "memory.nc")
+    assert_same_bits(read_result(tmp_path / "result.nc"), read_result(tmp_path / "memory.nc"))
+    assert not (tmp_path / "checkpoint").exists()  # removed once result.nc is written
+
+
+def test_dask_cluster_gives_the_same_bits(reference):
+    distributed = pytest.importorskip("distributed")
+    cfg, ref = reference
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc:
+        assert_same_bits(slidernet.run(cfg, scheduler=lc.scheduler_address), ref)
+
+
+def test_more_realizations_than_a_reduction_chunk(tmp_path):
+    """2500 realizations (three chunks of the on-the-fly reduction): stored in chunks of 1024 realizations."""
+    cfg = {**PAIR, "realizations": 2500, "steps": 20, "observables": ["n", "mu_max", "x_G"]}
+    mem = slidernet.run(cfg, workers=2)
+    with slidernet.run(cfg, workers=2, out=tmp_path) as ds:
+        assert_same_bits(ds.load(), mem)
+    x = mem["x_G"].values
+    np.testing.assert_allclose(mem["x_G_mean"], x.mean(axis=0), rtol=1e-12, atol=1e-30)
+    np.testing.assert_allclose(mem["x_G_sem"], x.std(axis=0, ddof=1) / 50, rtol=1e-10, atol=1e-30)
+    with netCDF4.Dataset(tmp_path / "result.nc") as nc:
+        assert nc["n"].chunking() == [1024, mem.sizes["t"]]
+
+
+def _write_toml(path: Path, cfg: dict) -> Path:
+    lines = []
+
+    def emit(table: dict, prefix: str) -> None:
+        scalars = {k: v for k, v in table.items() if not isinstance(v, dict)}
+        if prefix:
+            lines.append(f"[{prefix}]")
+        for k, v in scalars.items():
+            lines.append(f"{k} = {json.dumps(v)}")
+        for k, v in table.items():
+            if isinstance(v, dict):
+                emit(v, f"{prefix}.{k}" if prefix else k)
+
+    emit(cfg, "")
+    path.write_text("\n".join(lines) + "\n")
+    assert tomllib.loads(path.read_text()) == cfg
+    return path
+
+
+# A run of a few seconds, made of realizations long enough to be caught in
+# the middle: a 12 x 12 triangular lattice with the event catalogue.
+LONG = {**LATTICE, "realizations": 4, "steps": 400, "network": {"kind": "triangular", "shape": [12, 12],
+                                                                  "Ntilde": 1e-7},
+        "execution": {"checkpoint_every": 0.2}}
+
+
+def _start(config: Path, out: Path, *extra: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out),
+                             "--no-progress", *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+
+
+def _wait_for(pattern: str, folder: Path, proc: subprocess.Popen, timeout: float = 120.0) -> None:
+    t0 = time.monotonic()
+    while not list(folder.glob(pattern)):
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - t0 < timeout, f"no {pattern} after {timeout} s"
+        time.sleep(0.05)
+
+
+@pytest.fixture(scope="module")
+def long_reference():
+    return slidernet.run(LONG, workers=1)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("workers", ["1", "2"], ids=["one-worker", "two-workers"])
+def test_resume_after_kill_9_gives_the_same_bits(tmp_path, long_reference, workers):
+    config = _write_toml(tmp_path / "long.toml", LONG)
+    out = tmp_path / "out"
+    proc = _start(config, out, "--workers", workers)
+    _wait_for("checkpoint/partial-*.npz", out, proc)
+    os.killpg(proc.pid, signal.SIGKILL)  # the whole session: workers die too, as in a machine failure
+    proc.wait()
+    assert not (out / "result.nc").exists()
+    for f in (out / "checkpoint").glob("*.npz"):
+        with np.load(f, allow_pickle=False) as z:  # plain numeric files: no pickle needed to read them
+            [z[k] for k in z.files]
+    done = subprocess.run([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out),
+                           "--no-progress", "--resume", "--workers", "2"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert_same_bits(read_result(out / "result.nc"), long_reference)
+    assert not (out / "checkpoint").exists()
+
+
+@pytest.mark.slow
+def test_ctrl_c_saves_and_says_how_to_resume(tmp_path, long_reference):
+    config = _write_toml(tmp_path / "long.toml", LONG)
+    out = tmp_path / "out"
+    proc = _start(config, out, "--workers", "1")
+    _wait_for("checkpoint/partial-*.npz", out, proc)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "--resume" in err and "interrupted" in err
+    assert not (out / "result.nc").exists()
+    assert list((out / "checkpoint").glob("*.npz"))
+    assert not list((out / "checkpoint").glob("*.tmp"))
+    # Without --resume the interrupted run is refused, not overwritten.
+    again = subprocess.run([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out)],
+                           capture_output=True, text=True)
+    assert again.returncode == 2 and "--resume" in again.stderr
+    with slidernet.run(LONG, out=out, resume=True, workers=1) as ds:
+        assert_same_bits(ds.load(), long_reference)
+
+
+def test_resume_refuses_another_config(tmp_path):
+    out = tmp_path / "out"
+    store_dir = out / "checkpoint"
+    with pytest.raises(KeyboardInterrupt):
+        slidernet.run(PAIR, out=out, workers=1, on_realization=_interrupt_after(2))
+    assert (store_dir / "run.json").exists()
+    other = {**PAIR, "driver": {"name": "gaussian_steps", "sigma_theta": 2e-6}}
+    with pytest.raises(CheckpointError, match=r"driver\.sigma_theta \(1e-06 in the checkpoint, 2e-06 now\)"):
+        slidernet.run(other, out=out, resume=True)
+    with pytest.raises(CheckpointError, match="realizations"):
+        slidernet.run({**PAIR, "realizations": 9}, out=out, resume=True)
+    # Another number of workers is not another run.
+    with slidernet.run(PAIR, out=out, resume=True, workers=2) as ds:
+        assert_same_bits(ds.load(), slidernet.run(PAIR, workers=1))
+
+
+def _interrupt_after(k: int):
+    def hook(r: int) -> None:
+        hook.calls += 1
+        if hook.calls == k:
+            raise KeyboardInterrupt
+
+    hook.calls = 0
+    return hook
+
+
+def test_interrupted_in_process_run_resumes_to_the_same_bits(tmp_path):
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt, match="resume"):
+        slidernet.run(PAIR, out=out, workers=1, on_realization=_interrupt_after(3))
+    stored = json.loads((out / "checkpoint" / "run.json").read_text())
+    assert stored["seed"] == 3 and stored["realizations"] == 5 and "execution" not in stored["config"]
+    with slidernet.run(PAIR, out=out, resume=True, workers=1) as ds:
+        assert_same_bits(ds.load(), slidernet.run(PAIR, workers=1))
+
+
+def test_fresh_seed_is_kept_across_a_resume(tmp_path):
+    cfg = {**PAIR, "seed": None}
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        slidernet.run(cfg, out=out, workers=1, on_realization=_interrupt_after(2))
+    seed = json.loads((out / "checkpoint" / "run.json").read_text())["seed"]
+    with slidernet.run(cfg, out=out, resume=True, workers=1) as ds:
+        assert ds.attrs["seed"] == str(seed)
+        assert_same_bits(ds.load(), slidernet.run({**cfg, "seed": seed}, workers=1))
+
+
+def test_resume_without_a_checkpoint_is_refused(tmp_path):
+    with pytest.raises(CheckpointError, match="Nothing to resume"):
+        slidernet.run(PAIR, out=tmp_path, resume=True)
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, True], ids=["zero", "negative", "float", "bool"])
+def test_bad_workers_are_refused(workers):
+    with pytest.raises(ConfigError, match="'workers' parameter of run must be an integer >= 1"):
+        slidernet.run(PAIR, workers=workers)
+
+
+@pytest.mark.parametrize("address", ["localhost:8786", "http://x:1", "tcp://"], ids=["no-scheme", "http", "empty"])
+def test_bad_scheduler_is_refused_before_any_work(address):
+    with pytest.raises(ConfigError, match="scheduler"):
+        slidernet.run({**PAIR, "execution": {"scheduler": address}})
+    with pytest.raises(ConfigError, match="scheduler"):
+        slidernet.run(PAIR, scheduler=address)
+
+
+def test_execution_is_not_part_of_the_recorded_config():
+    ds = slidernet.run({**PAIR, "realizations": 2, "steps": 10, "execution": {"workers": 2}})
+    assert "execution" not in json.loads(ds.attrs["config"])
+    assert json.loads(ds.attrs["execution"]) == {"workers": 2, "scheduler": None}
