@@ -29,6 +29,7 @@ import functools
 import json
 import multiprocessing
 import os
+import signal
 import time
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -71,28 +72,59 @@ def scene_of(config_json: str):
     return Scene.from_config(load_config(json.loads(config_json)))
 
 
+class _DeferredInterrupt:
+    """Hold Ctrl-C (SIGINT) until the realization is at a clean point between two steps.
+
+    A KeyboardInterrupt raised inside :meth:`Realization.advance` would leave
+    the state between a kernel's return and Python's handling of it (a refill,
+    a flushed event chunk): saving that would not resume to the same bits.
+    Only the main thread of a process can hold signals; elsewhere (a Dask
+    worker thread) this does nothing.
+    """
+
+    def __init__(self) -> None:
+        self.pending = False
+        self._previous = None
+
+    def __enter__(self) -> _DeferredInterrupt:
+        try:
+            self._previous = signal.signal(signal.SIGINT, self._hold)
+        except ValueError:  # not the main thread
+            self._previous = None
+        return self
+
+    def _hold(self, signum, frame) -> None:
+        self.pending = True
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+
+
 def _advance_with_checkpoints(real, partial: Path, every: float, meta: dict[str, Any]) -> None:
     """Advance ``real`` to its end, saving it to ``partial`` every ``every`` seconds and on Ctrl-C."""
     from slidernet.checkpoint import save_realization
 
     steps = real.scene.steps
     chunk = 1
+    # Chunks of at most a tenth of the interval, and half a second: a
+    # checkpoint or a Ctrl-C is never served much later than asked, and the
+    # Python overhead per chunk stays negligible.
+    target = min(0.1 * every, 0.5)
     last = time.monotonic()
-    try:
+    with _DeferredInterrupt() as sigint:
         while real.step < steps:
             t0 = time.monotonic()
             real.advance(min(real.step + chunk, steps))
-            # Chunks of about a tenth of the interval: a checkpoint is never
-            # much later than asked, and the Python overhead stays negligible.
             took = time.monotonic() - t0
-            chunk = max(1, min(2 * chunk, int(chunk * 0.1 * every / took) if took > 0 else 2 * chunk))
+            chunk = max(1, min(2 * chunk, int(chunk * target / took) if took > 0 else 2 * chunk))
+            if sigint.pending:
+                if real.step < steps:
+                    save_realization(real, partial, meta)
+                raise KeyboardInterrupt
             if real.step < steps and time.monotonic() - last >= every:
                 save_realization(real, partial, meta)
                 last = time.monotonic()
-    except KeyboardInterrupt:
-        if real.step < steps:
-            save_realization(real, partial, meta)
-        raise
 
 
 def run_realization(config_json: str, seed: int, r: int, partial: str | None = None,
