@@ -1,0 +1,398 @@
+"""Checkpoints of one realization in the middle of its run, resumed to the same bits.
+
+Between two calls of :meth:`Realization.advance` a realization is at a clean
+point: its whole state is in arrays and in the states of its three random
+streams. :func:`save_realization` writes that state to one ``.npz`` file
+(numpy's zip of ``.npy`` arrays; nothing is pickled) and
+:func:`load_realization` rebuilds the realization from its scene and seed and
+overwrites its state from the file. Advancing the loaded realization gives
+the bits an uninterrupted run gives.
+
+File layout (keys of the ``.npz``; every array numeric):
+
+``header``
+    uint8, the UTF-8 JSON text of: ``format`` and ``version`` of the layout,
+    ``meta`` (the caller's, e.g. config hash, realization index, version),
+    ``scene`` (a fingerprint of the scene: kernel, sizes, batch, ... and
+    digests of K, g, the loads and the recorded times), ``thetas`` (a digest
+    of theta(t_q)), ``rngs`` (the ``bit_generator.state`` of the driver,
+    thresholds and tilt streams), ``step`` and ``n`` (for information),
+    ``tilted``, ``events_complete``, ``ev_rows`` and ``numpy``.
+``state/<name>``
+    The arrays of the realization: ``ist``, ``fst``, ``mu``, ``mu_buf``,
+    ``tmu``, ``tu``, and for the network kernels ``a``, ``u``, ``hp``,
+    ``hpos``, ``hv``, ``aval_hist``, ``node_slips``.
+``out/<name>``
+    The records written so far (every key of ``Realization.out``).
+``events/buffer_i``, ``events/buffer_f``
+    Network kernels: the catalogue rows in the kernel's buffer (its first
+    ``ist[EV_POS]`` rows).
+``events/chunks_i``, ``events/chunks_f``, ``events/chunk_rows``
+    Network kernels: the chunks already handed to Python, concatenated, and
+    the number of rows of each.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from slidernet import kernels
+from slidernet.errors import CheckpointError
+from slidernet.io import atomic_output
+from slidernet.solver import Realization, Scene
+
+FORMAT = "slidernet-checkpoint"
+VERSION = 1
+
+# Arrays whose shape and dtype are fixed by the scene: copied into the fresh realization's own.
+_FIXED = ("ist", "fst", "mu")
+_FIXED_NETWORK = ("a", "u", "hp", "hpos", "hv", "aval_hist", "node_slips")
+# Draw buffers: their length changes when they are refilled.
+_BUFFERS = ("mu_buf", "tmu", "tu")
+# Attributes written to the file by name (arrays above, or special handling below).
+_SAVED = {*_FIXED, *_FIXED_NETWORK, *_BUFFERS, "out", "rngs", "ev_i", "ev_f", "_event_chunks",
+          "events_complete", "_tilted"}
+# Attributes the constructor rebuilds, and why that is exact.
+_REBUILT = {
+    "scene": "passed to load_realization",
+    "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
+    "_mu_batches": "a generator reading rngs['thresholds'], whose state is restored in place",
+    "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
+}
+
+
+def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) -> Path:
+    """Write the state of ``real`` to one ``.npz`` file, atomically.
+
+    The file is written next to ``path`` under a temporary name, flushed to
+    disk, then renamed over ``path``: an interrupted save leaves the previous
+    checkpoint as it was. Call it between two :meth:`Realization.advance`
+    calls.
+
+    Parameters
+    ----------
+    real : Realization
+        The realization, at a step boundary.
+    path : str or Path
+        The checkpoint file (``.npz`` by convention; no suffix is added).
+    meta : dict
+        JSON-serializable values that identify the run (config hash,
+        realization index, slidernet version, ...), checked by
+        :func:`load_realization`.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    CheckpointError
+        If ``meta`` is not JSON-serializable, or ``real`` holds an attribute
+        this module does not know how to save (a new piece of state).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from slidernet.config import load_config
+    >>> cfg = load_config({"steps": 30, "network": {"Ntilde": 1e-7}, "driver": {"name": "gaussian_steps",
+    ...     "sigma_theta": 1e-6}, "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6,
+    ...     "std": 0.01}}})
+    >>> scene, ss = Scene.from_config(cfg), np.random.SeedSequence(7)
+    >>> real = Realization(scene, ss).advance(10)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = save_realization(real, Path(folder) / "r0.npz", {"realization": 0})
+    ...     resumed = load_realization(scene, ss, path, {"realization": 0})
+    >>> resumed.step
+    10
+    >>> resumed.advance().result()["n"].tolist() == real.advance().result()["n"].tolist()
+    True
+    """
+    unknown = sorted(set(vars(real)) - _SAVED - set(_REBUILT))
+    if unknown:
+        raise CheckpointError(
+            f"The realization holds {unknown} that slidernet.checkpoint neither saves nor rebuilds; "
+            "add each to checkpoint._SAVED (and save it) or to checkpoint._REBUILT."
+        )
+    network = real.scene.kernel != "pair"
+    header: dict[str, Any] = {
+        "format": FORMAT,
+        "version": VERSION,
+        "meta": meta,
+        "scene": _fingerprint(real.scene),
+        "thetas": _digest(real.thetas),
+        "rngs": {name: rng.bit_generator.state for name, rng in real.rngs.items()},
+        "step": real.step,
+        "n": real.n,
+        "tilted": int(real._tilted),
+        "events_complete": bool(real.events_complete) if network else True,
+        "ev_rows": int(real.ev_i.shape[0]) if network else 0,
+        "numpy": np.__version__,
+    }
+    try:
+        text = json.dumps(header, sort_keys=True, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise CheckpointError(f"The checkpoint meta must be JSON-serializable: {exc}.") from None
+    arrays = {"header": np.frombuffer(text.encode("utf-8"), dtype=np.uint8)}
+    for name in _FIXED + _BUFFERS + (_FIXED_NETWORK if network else ()):
+        arrays[f"state/{name}"] = getattr(real, name)
+    for name, values in real.out.items():
+        arrays[f"out/{name}"] = values
+    if network:
+        k = int(real.ist[kernels.EV_POS])
+        # Rows past EV_POS are stale: the kernel writes a row before anything reads it.
+        arrays["events/buffer_i"] = real.ev_i[:k]
+        arrays["events/buffer_f"] = real.ev_f[:k]
+        chunks = real._event_chunks
+        arrays["events/chunk_rows"] = np.array([c[0].shape[0] for c in chunks], dtype=np.int64)
+        arrays["events/chunks_i"] = np.concatenate([np.zeros((0, 2), np.int64)] + [c[0] for c in chunks])
+        arrays["events/chunks_f"] = np.concatenate([np.zeros((0, 3))] + [c[1] for c in chunks])
+    odd = sorted(key for key, a in arrays.items() if a.dtype.kind not in "biuf")
+    if odd:  # np.savez would pickle them, and load_realization refuses pickles
+        raise CheckpointError(f"The checkpoint arrays {odd} are not numeric.")
+    path = Path(path)
+    with atomic_output(path) as tmp:
+        with open(tmp, "wb") as fh:  # a file object: np.savez would append ".npz" to a name
+            np.savez(fh, **arrays)
+            fh.flush()
+            # The rename is atomic, but only data on disk survives a machine failure.
+            os.fsync(fh.fileno())
+    _fsync_folder(path.parent)
+    return path
+
+
+def load_realization(scene: Scene, seed_seq: np.random.SeedSequence, path: str | Path,
+                     expect_meta: dict[str, Any] | None = None) -> Realization:
+    """Rebuild a realization from its scene, its seed and a checkpoint file.
+
+    The realization is constructed as usual, then its state (arrays, records,
+    event catalogue, random streams) is overwritten from the file, which is
+    read with ``allow_pickle=False``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene of the run (built afresh from the same config).
+    seed_seq : numpy.random.SeedSequence
+        The realization's seed, as given to the saved realization.
+    path : str or Path
+        A file written by :func:`save_realization`.
+    expect_meta : dict, optional
+        Every key must be in the file's meta with an equal value (after a
+        JSON round trip); keys the file has beyond these are not checked.
+
+    Returns
+    -------
+    Realization
+        At the saved step; :meth:`Realization.advance` goes on from there.
+
+    Raises
+    ------
+    CheckpointError
+        If the file is truncated, corrupt or not a checkpoint, if its meta
+        differs from ``expect_meta``, or if it was written for another scene
+        or another theta(t_q). ``FileNotFoundError`` if there is no file.
+    """
+    path = Path(path)
+    header, arrays = _read(path)
+    if expect_meta is not None:
+        _check_meta(path, header.get("meta"), expect_meta)
+    _check_same(path, "scene", header.get("scene"), _fingerprint(scene))
+    real = Realization(scene, seed_seq)
+    if header.get("thetas") != _digest(real.thetas):
+        raise CheckpointError(
+            f"The checkpoint {str(path)!r} was saved with other theta(t_q) for this seed: the driver (or its "
+            "input file, or numpy) has changed, or this is another realization's seed."
+        )
+    try:
+        _restore(real, header, arrays)
+    except KeyError as exc:
+        raise CheckpointError(f"The checkpoint {str(path)!r} is inconsistent: its header has no {exc}.") from None
+    except (TypeError, ValueError) as exc:
+        raise CheckpointError(f"The checkpoint {str(path)!r} is inconsistent: {exc}.") from None
+    return real
+
+
+def checkpoint_info(path: str | Path) -> dict[str, Any]:
+    """The header of a checkpoint: its ``meta``, ``step``, ``n`` and the rest (see the module docstring).
+
+    Reads and checks the whole file (a corrupt one raises :class:`CheckpointError`).
+    """
+    return _read(Path(path))[0]
+
+
+def _read(path: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """The header and the arrays of a checkpoint file, every array read (so every CRC checked)."""
+    with open(path, "rb") as fh:
+        if fh.read(6) == b"\x93NUMPY":
+            raise CheckpointError(f"The file {str(path)!r} is a single .npy array, not a slidernet checkpoint.")
+    try:
+        # numpy reads a member only up to the length its .npy header gives, and zipfile checks a
+        # CRC only at the end of a member: a damaged header length would go unnoticed (found by
+        # flipping bytes). testzip reads every member to its end.
+        with zipfile.ZipFile(path) as zf:
+            damaged = zf.testzip()
+        if damaged is not None:
+            raise zipfile.BadZipFile(f"bad CRC-32 for {damaged!r}")
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {name: npz[name] for name in npz.files}
+    except (PermissionError, IsADirectoryError):
+        raise
+    except Exception as exc:
+        # Damage surfaces as many exception types: flipping random bytes of a checkpoint gave
+        # BadZipFile, EOFError, NotImplementedError (zipfile), ValueError and TokenError (the .npy header).
+        raise _unreadable(path, exc) from None
+    raw = arrays.pop("header", None)
+    try:
+        header = json.loads(raw.tobytes().decode("utf-8")) if raw is not None and raw.dtype == np.uint8 else None
+    except (UnicodeDecodeError, ValueError):
+        header = None
+    if not isinstance(header, dict) or header.get("format") != FORMAT:
+        raise CheckpointError(f"The file {str(path)!r} is not a slidernet checkpoint (no valid header).")
+    if header.get("version") != VERSION:
+        raise CheckpointError(
+            f"The checkpoint {str(path)!r} has layout version {header.get('version')!r}; "
+            f"this slidernet reads version {VERSION}."
+        )
+    return header, arrays
+
+
+def _unreadable(path: Path, exc: BaseException) -> CheckpointError:
+    return CheckpointError(
+        f"The checkpoint {str(path)!r} cannot be read: it is truncated or corrupt "
+        f"({type(exc).__name__}: {exc})."
+    )
+
+
+def _check_meta(path: Path, saved: Any, expect: dict[str, Any]) -> None:
+    # The round trip compares what JSON can store: a tuple expected matches the list saved.
+    expect = json.loads(json.dumps(expect))
+    saved = saved if isinstance(saved, dict) else {}
+    for key, want in expect.items():
+        if key not in saved:
+            raise CheckpointError(f"The checkpoint {str(path)!r} has no meta entry {key!r} (expected {want!r}).")
+        if saved[key] != want:
+            raise CheckpointError(
+                f"The checkpoint {str(path)!r} belongs to another run: its meta {key!r} is "
+                f"{saved[key]!r}, expected {want!r}."
+            )
+
+
+def _check_same(path: Path, what: str, saved: Any, here: dict[str, Any]) -> None:
+    saved = saved if isinstance(saved, dict) else {}
+    for key, value in here.items():
+        if saved.get(key) != value:
+            raise CheckpointError(
+                f"The checkpoint {str(path)!r} was written for another {what}: its {key!r} is "
+                f"{saved.get(key)!r} there and {value!r} here."
+            )
+
+
+def _fingerprint(scene: Scene) -> dict[str, Any]:
+    """What a continuation depends on in the scene, beyond the seed (JSON values)."""
+    net, K = scene.network, scene.K
+    return {
+        "kernel": scene.kernel,
+        "n_nodes": int(net.n_nodes),
+        "dim": int(net.dim),
+        "Ntilde": float(net.Ntilde),
+        "mu_d": float(scene.mu_d),
+        "steps": int(scene.steps),
+        "rec_times": _digest(scene.rec_times),
+        "tilt_at": scene.tilt_at,
+        "catalogue": bool(scene.catalogue),
+        "max_events": int(scene.max_events),
+        "batch": int(scene.batch),
+        "recompute_every": int(scene.recompute_every),
+        "max_avalanche": int(scene.max_avalanche),
+        "slip_mode": int(scene.slip_mode),
+        "distribution": scene.distribution_name,
+        "driver": scene.driver_name,
+        "K": _digest(K.indptr, K.indices, K.data),
+        "loads": _digest(scene.ops["g"], net.normal_load, net.f_ext),
+    }
+
+
+def _digest(*arrays: np.ndarray) -> str:
+    """A hash of the arrays' dtypes, shapes and bytes (hex)."""
+    # sha256: twice blake2b's speed here (1.2 against 0.5 GB/s), and K of a 1e5-node lattice is 30 MB.
+    h = hashlib.sha256()
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.data)
+    return h.hexdigest()[:32]
+
+
+def _take(arrays: dict[str, np.ndarray], key: str, like: np.ndarray | None = None, *,
+          dtype: Any = None, ndim: int | None = None) -> np.ndarray:
+    """``arrays[key]``, checked against ``like``'s dtype and shape (or ``dtype`` and ``ndim``)."""
+    if key not in arrays:
+        raise ValueError(f"it has no array {key!r}")
+    a = arrays[key]
+    dtype = like.dtype if like is not None else np.dtype(dtype)
+    if a.dtype != dtype or (like is not None and a.shape != like.shape) or (ndim is not None and a.ndim != ndim):
+        want = like.shape if like is not None else f"{ndim} dimensions"
+        raise ValueError(f"array {key!r} is {a.dtype}{a.shape}, expected {dtype} {want}")
+    return a
+
+
+def _restore(real: Realization, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    """Overwrite the state of a freshly constructed ``real`` (same scene and seed) from a checkpoint."""
+    network = real.scene.kernel != "pair"
+    # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
+    for name in _FIXED + (_FIXED_NETWORK if network else ()):
+        target = getattr(real, name)
+        target[...] = _take(arrays, f"state/{name}", target)
+    for name in _BUFFERS:
+        setattr(real, name, np.array(_take(arrays, f"state/{name}", dtype=np.float64, ndim=1), order="C"))
+    saved_out = {key.removeprefix("out/") for key in arrays if key.startswith("out/")}
+    if saved_out != set(real.out):
+        raise ValueError(f"its records are {sorted(saved_out)}, this scene's are {sorted(real.out)}")
+    for name, target in real.out.items():
+        target[...] = _take(arrays, f"out/{name}", target)
+    if network:
+        k, rows = int(real.ist[kernels.EV_POS]), int(header["ev_rows"])
+        if not 0 <= k <= rows:
+            raise ValueError(f"{k} catalogue rows are written in a buffer of {rows}")
+        real.ev_i = np.zeros((rows, 2), np.int64)
+        real.ev_f = np.zeros((rows, 3))
+        real.ev_i[:k] = _take(arrays, "events/buffer_i", real.ev_i[:k])
+        real.ev_f[:k] = _take(arrays, "events/buffer_f", real.ev_f[:k])
+        counts = _take(arrays, "events/chunk_rows", dtype=np.int64, ndim=1)
+        ev_i = _take(arrays, "events/chunks_i", dtype=np.int64, ndim=2)
+        ev_f = _take(arrays, "events/chunks_f", dtype=np.float64, ndim=2)
+        total = int(counts.sum())
+        if (counts < 0).any() or ev_i.shape != (total, 2) or ev_f.shape != (total, 3):
+            raise ValueError(f"the catalogue chunks of {counts.tolist()} rows are {ev_i.shape} and {ev_f.shape}")
+        cuts = np.cumsum(counts)[:-1]
+        real._event_chunks = [(i.copy(), f.copy()) for i, f in zip(np.split(ev_i, cuts), np.split(ev_f, cuts),
+                                                                     strict=True)] if counts.size else []
+        real.events_complete = bool(header["events_complete"])
+    real._tilted = int(header["tilted"])
+    if set(header["rngs"]) != set(real.rngs):
+        raise ValueError(f"its streams are {sorted(header['rngs'])}, a realization's are {sorted(real.rngs)}")
+    for name, rng in real.rngs.items():
+        # In place: the threshold batches come from a generator holding this very Generator.
+        rng.bit_generator.state = header["rngs"][name]
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Put the rename itself on disk (POSIX; a no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
