@@ -13,8 +13,10 @@ from importlib.metadata import PackageNotFoundError, version
 
 from slidernet.errors import (
     AvalancheError,
+    CheckpointError,
     ConfigError,
     PluginError,
+    RunInterrupted,
     SlidernetError,
     TiltTestError,
     UnknownPluginError,
@@ -28,8 +30,10 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 __all__ = [
     "AvalancheError",
+    "CheckpointError",
     "ConfigError",
     "PluginError",
+    "RunInterrupted",
     "SlidernetError",
     "TiltTestError",
     "UnknownPluginError",
@@ -41,8 +45,9 @@ __all__ = [
 ]
 
 
-_SUBMODULES = {"builders", "distributions", "drivers", "io", "network", "observables", "plots", "registry",
-               "solver", "testing", "theory", "units"}
+_SUBMODULES = {"builders", "checkpoint", "distributions", "drivers", "dynamics", "execution", "io", "network",
+               "observables", "plots", "registry", "solver", "speed_error", "store", "sweep", "testing", "theory",
+               "units"}
 
 
 def __getattr__(name: str):
