@@ -112,17 +112,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from slidernet.sweep import parse_set, sweep
+    from slidernet.sweep import parse_grid, sweep
 
-    grid = dict(parse_set(text) for text in args.sets)
-    if len(grid) != len(args.sets):
-        from slidernet.errors import ConfigError
-
-        raise ConfigError("A key is given twice with --set; give each key once, with all its values.")
-    ds = sweep(args.config, grid, progress=not args.no_progress, out=args.out, resume=args.resume,
-               workers=args.workers, scheduler=args.scheduler)
-    dims = ", ".join(f"{d} = {ds.sizes[d]}" for d in ds.dims if d not in ("realization", "t"))
-    print(f"wrote {args.out / 'result.nc'} ({dims})")
+    ds = sweep(args.config, parse_grid(args.sets), progress=not args.no_progress, out=args.out,
+               resume=args.resume, workers=args.workers, scheduler=args.scheduler)
+    swept = [name for name in ds.dims if "sweep_key" in ds[name].attrs]
+    print(f"wrote {args.out / 'result.nc'} ({' x '.join(f'{ds.sizes[d]} {d}' for d in swept)} points)")
     return 0
 
 

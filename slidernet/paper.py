@@ -20,7 +20,9 @@ curves drawn on the figure as variables. Run it from the command line with
 
 The simulations are those of :func:`slidernet.run` (same seeds, same
 dataset), driven realization by realization so that a single progress bar
-covers the whole reproduction.
+covers the whole reproduction. Panel b of figure 3 is one
+:func:`slidernet.sweep.sweep` over sigma_theta: every point runs with the
+same seed (common random numbers).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ import slidernet
 from slidernet import theory
 from slidernet.config import load_config
 from slidernet.io import write_netcdf
+from slidernet.sweep import sweep as run_sweep
 
 __all__ = ["FULL", "QUICK", "Preset", "reproduce"]
 
@@ -152,8 +155,26 @@ class _Runner:
         self.bar.set_postfix_str(job.label)
         return slidernet.run(job.config, progress=False, on_realization=lambda _: self.bar.update(step))
 
+    def sweep(self, jobs: list[_Job], key: str) -> xr.Dataset:
+        """One :func:`slidernet.sweep.sweep` over ``key``: point i is ``jobs[i]`` (same config but ``key``)."""
+        values = [_get(j.config, key) for j in jobs]
+        steps = [_cost_per_realization(j.config) for j in jobs]
+
+        def done(i: int, _: int) -> None:
+            self.bar.set_postfix_str(jobs[i].label)
+            self.bar.update(steps[i])
+
+        return run_sweep(jobs[0].config, {key: values}, progress=False, on_realization=done)
+
     def close(self) -> None:
         self.bar.close()
+
+
+def _get(config: dict[str, Any], key: str) -> Any:
+    """The value of a dotted key of a config dict."""
+    for part in key.split("."):
+        config = config[part]
+    return config
 
 
 def _stack(runs: list[xr.Dataset], dim: str, coords: dict[str, Any]) -> xr.Dataset:
@@ -319,17 +340,17 @@ def _plot_fig2(ds: xr.Dataset, path: Path) -> None:
 # figure 3: rearrangements
 
 
-def _fig3_data(run_a: xr.Dataset, sweep: list[xr.Dataset], sigmas: tuple[float, ...],
-               labels: list[str]) -> xr.Dataset:
+def _fig3_data(run_a: xr.Dataset, sweep: xr.Dataset, labels: list[str]) -> xr.Dataset:
+    """Panel a's run and panel b's sweep over sigma_theta; ``labels``: panel a's, then each sweep point's."""
     a = run_a.rename({"t": "t_a", "realization": "realization_a", "r_mean": "r_mean_a", "r_sem": "r_sem_a"})
     a = _no_attrs(a)
     a["t_a"].attrs.update(long_name="time (panel a, linear grid)", units="tau_th")
-    s = np.asarray(sigmas, dtype=float)
+    s = sweep["sigma_theta"].values.astype(float)
     b = xr.Dataset(coords={"sigma_theta": ("sigma_theta", s, {
         "long_name": "standard deviation of the dilation theta (panel b sweep)", "units": "1"})})
-    b["r_mean"] = ("sigma_theta", np.array([float(r["r_mean"]) for r in sweep]),
+    b["r_mean"] = ("sigma_theta", sweep["r_mean"].values,
                    {"long_name": "measured mean rearrangements per tau_th", "units": "1"})
-    b["r_sem"] = ("sigma_theta", np.array([float(r["r_sem"]) for r in sweep]),
+    b["r_sem"] = ("sigma_theta", sweep["r_sem"].values,
                   {"long_name": "standard error of r_mean", "units": "1"})
     b["r_slope"] = ("sigma_theta", theory.mean_rearrangements(s, NTILDE, MU_D, MU_S_MEAN), {
         "long_name": "eq. slope (with offset mu_d Ntilde)", "units": "1"})
@@ -340,7 +361,10 @@ def _fig3_data(run_a: xr.Dataset, sweep: list[xr.Dataset], sigmas: tuple[float, 
         "sigma_theta"]), NTILDE, MU_D, MU_S_MEAN)), {"long_name": "eq. slope at panel a's sigma_theta",
                                                       "units": "1"})
     ds.attrs = _file_attrs("Fig. rearrangement of Géminard & Bertin (2010): (a) n(t), (b) <r>(sigma_theta)",
-                           labels, [run_a, *sweep])
+                           labels[:1], [run_a])
+    configs = json.loads(ds.attrs["configs"])
+    configs.update(zip(labels[1:], json.loads(sweep.attrs["configs"]), strict=True))
+    ds.attrs["configs"] = json.dumps(configs, sort_keys=True)
     return ds
 
 
@@ -514,9 +538,10 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
     job3a = _Job(f"panel_a_sigma_theta={p.fig3a_sigma:g}",
                  _config(p.fig3a_sigma, p.fig3a_steps, p.fig3a_realizations, p.seed + 100, observables=("n",),
                          record=t_lin))
-    jobs3b = [_Job(f"sweep_sigma_theta={s:.4g}", _config(s, p.fig3b_steps, p.fig3b_realizations, p.seed + 200 + i,
+    # One sweep: every sigma_theta runs with the same seed (common random numbers, slidernet.sweep).
+    jobs3b = [_Job(f"sweep_sigma_theta={s:.4g}", _config(s, p.fig3b_steps, p.fig3b_realizations, p.seed + 200,
                                                          observables=("n",)))
-              for i, s in enumerate(p.fig3b_sigmas)]
+              for s in p.fig3b_sigmas]
     cases = _fig4_cases(p)
     jobs4 = [_Job(f"mu_d={md:g}_ratio={rr:g}",
                   _config(p.fig4_sigma_theta, p.fig4_steps, p.fig4_realizations, p.seed + 300 + k, mu_d=md,
@@ -551,8 +576,8 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
 
         t0 = time.perf_counter()
         run3a = runner.run(job3a)
-        sweep = [runner.run(j) for j in jobs3b]
-        ds3 = _fig3_data(run3a, sweep, p.fig3b_sigmas, [job3a.label] + [j.label for j in jobs3b])
+        sweep3b = runner.sweep(jobs3b, "driver.sigma_theta")
+        ds3 = _fig3_data(run3a, sweep3b, [job3a.label] + [j.label for j in jobs3b])
         t_sim3 = time.perf_counter() - t0
         t0 = time.perf_counter()
         files["fig3_rearrangements.nc"] = write_netcdf(ds3, out / "fig3_rearrangements.nc")
@@ -582,7 +607,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
         "wall_time_s": {**wall, "total_s": time.perf_counter() - start},
         "measured_r_mean": {
             "fig1_fig2": {j.label: float(r["r_mean"]) for j, r in zip(jobs12, runs12, strict=True)},
-            "fig3b": {j.label: float(r["r_mean"]) for j, r in zip(jobs3b, sweep, strict=True)},
+            "fig3b": {j.label: float(r) for j, r in zip(jobs3b, sweep3b["r_mean"].values, strict=True)},
             "fig4": {j.label: float(r["r_mean"]) for j, r in zip(jobs4, runs4, strict=True)},
         },
         "slidernet_version": slidernet.__version__,

@@ -1,0 +1,600 @@
+"""Parameter sweeps: one configuration, a grid of values of some of its keys, one dataset.
+
+``slidernet sweep CONFIG --set driver.sigma_theta=1e-7,3e-7,1e-6`` and
+:func:`sweep` run every point of the product grid with :func:`slidernet.run`
+and stack the points' datasets along one dimension per swept key.
+
+Rules
+-----
+Seeds
+    Every point runs with the configuration's seed, unchanged (common random
+    numbers): realization r of every point is driven by the same child of the
+    seed, so the differences between points are less noisy than the points
+    themselves, and a point of a sweep is the plain run of its configuration,
+    bit for bit. A seed of None is resolved once (fresh entropy) and shared by
+    every point. ``seed`` cannot be swept; ``realizations`` gives
+    independent samples.
+Dimensions
+    One per swept key, in the order given, named after the key's last
+    component (``driver.sigma_theta`` -> ``sigma_theta``), or after the full
+    dotted key when that name is taken: by another swept key with the same
+    last component, or by a variable, coordinate or dimension of the result
+    (``network.n`` and the variable ``n``). The coordinate holds the values
+    in the order given: numbers, booleans or strings; list or table values
+    (``network.shape``) are stored as their JSON text. Every per-point
+    variable gains the sweep dimensions in front: ``n`` is
+    ``(sigma_theta, realization, t)``, ``r_mean`` is ``(sigma_theta,)``.
+Times
+    The points are stacked along one time axis ``t``, never padded (the
+    sweep itself puts no NaN in a result). The combined ``t`` is the
+    recorded times of the point with the fewest ``steps``, and every other
+    point's recorded times must begin with exactly those; its records after
+    them are left out of the combined dataset (a point's ``mu_eff`` bins
+    (t_{k-1}, t_k] stay its own; scalars such as ``r_mean`` are each point's
+    own, over its full run). So ``steps`` can be swept with ``record =
+    "all"``, with an explicit ``record`` list that holds every smaller
+    ``steps`` value of the sweep, or with ``record = "log"`` over whole
+    decades (100, 1000, ...: a log grid spreads its points over the whole
+    run). Any other difference in the recorded times is refused before any
+    work.
+Layout
+    Every point must give the same variables along the same dimensions: the
+    same number of realizations, the same observables, and a scene with the
+    same kernel, dimension and number of nodes. The event catalogue (whose
+    length differs from run to run) cannot be swept. All of this, and the
+    validity of every point's configuration, is checked before any work.
+
+With ``out``, point i (its grid position in C order: the last key varies
+fastest) runs in ``out/points/<i>/`` with the runner's checkpoints there, and
+the combined dataset is written atomically to ``out/result.nc``.
+``out/sweep.json`` holds the base configuration, the grid and the resolved
+seed, so a killed sweep resumes point by point (``resume=True``): finished
+points are read back, the interrupted one continues from its checkpoints,
+the rest run; a sweep with another configuration or grid is refused there.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import json
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from numbers import Number
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from tqdm.auto import tqdm
+
+import slidernet
+from slidernet import runner
+from slidernet.config import Config, load_config
+from slidernet.errors import CheckpointError, ConfigError, RunInterrupted
+from slidernet.io import atomic_output, read_result, write_netcdf
+from slidernet.solver import Scene, record_times
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = ["parse_grid", "parse_set", "sweep"]
+
+_KEY = re.compile(r"[A-Za-z0-9_-]+(\.[A-Za-z0-9_-]+)*")
+# Keys that a sweep refuses, with the reason.
+_UNSWEEPABLE = {
+    "seed": "every point runs with the configuration's seed (common random numbers); "
+            "raise 'realizations' for more independent samples",
+    "execution": "the [execution] table never changes a result; pass workers= or scheduler= instead",
+}
+
+
+# ---------------------------------------------------------------------------
+# parsing --set
+
+
+def parse_set(text: str) -> tuple[str, list[Any]]:
+    """Parse one ``KEY=V1,V2,...`` assignment of ``slidernet sweep --set``.
+
+    Each value is read as a TOML value (integers, floats, booleans, quoted
+    strings, arrays such as ``[4, 4]``, inline tables); a value that is not
+    TOML is read as a Python float if it is one (``.5``), else as a bare
+    string (``chain``). Commas inside brackets, braces or quotes do not
+    split values.
+
+    Parameters
+    ----------
+    text : str
+        ``KEY=V1,V2,...``; KEY is a dotted configuration key.
+
+    Returns
+    -------
+    key : str
+        The dotted key.
+    values : list
+        The values, in the order given.
+
+    Raises
+    ------
+    ConfigError
+        Without ``=``, with an empty key or value, a malformed key or value,
+        or a value given twice.
+
+    Examples
+    --------
+    >>> parse_set("driver.sigma_theta=1e-7,3e-7")
+    ('driver.sigma_theta', [1e-07, 3e-07])
+    >>> parse_set("network.shape=[2, 2],[4, 4]")
+    ('network.shape', [[2, 2], [4, 4]])
+    >>> parse_set("network.kind=chain,two_slider")
+    ('network.kind', ['chain', 'two_slider'])
+    """
+    key, sep, rhs = text.partition("=")
+    key = key.strip()
+    if not sep:
+        raise ConfigError(f"A sweep assignment reads KEY=V1,V2,...; {text!r} has no '='.")
+    _check_key(key)
+    items = _split_values(rhs, text)
+    values = []
+    for k, item in enumerate(items, start=1):
+        if not item:
+            raise ConfigError(f"The sweep assignment {text!r} has an empty value (value {k}).")
+        values.append(_parse_value(item, text))
+    _check_distinct(key, values)
+    return key, values
+
+
+def parse_grid(texts: Sequence[str]) -> dict[str, list[Any]]:
+    """Parse several ``--set`` assignments into a grid for :func:`sweep`.
+
+    Raises
+    ------
+    ConfigError
+        If an assignment is malformed (see :func:`parse_set`) or a key is
+        given twice.
+
+    Examples
+    --------
+    >>> parse_grid(["driver.sigma_theta=1e-7,1e-6", "friction.mu_d=0.4,0.5"])
+    {'driver.sigma_theta': [1e-07, 1e-06], 'friction.mu_d': [0.4, 0.5]}
+    """
+    grid: dict[str, list[Any]] = {}
+    for text in texts:
+        key, values = parse_set(text)
+        if key in grid:
+            raise ConfigError(f"The sweep key {key!r} is given twice; give all its values in one "
+                              f"assignment: {key}=V1,V2,...")
+        grid[key] = values
+    return grid
+
+
+def _split_values(rhs: str, text: str) -> list[str]:
+    """The comma-separated items of ``rhs``, stripped; commas in brackets, braces or quotes kept."""
+    items, depth, quote, start = [], 0, "", 0
+    for i, ch in enumerate(rhs):
+        if quote:
+            if ch == quote:
+                quote = ""
+        elif ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+        elif ch == "," and depth == 0:
+            items.append(rhs[start:i].strip())
+            start = i + 1
+    if quote or depth:
+        raise ConfigError(f"The sweep assignment {text!r} has an unclosed quote or bracket.")
+    items.append(rhs[start:].strip())
+    return items
+
+
+def _parse_value(item: str, text: str) -> Any:
+    try:
+        parsed = tomllib.loads(f"v = {item}")
+    except tomllib.TOMLDecodeError:
+        parsed = None
+    if parsed is not None and list(parsed) == ["v"]:
+        return parsed["v"]
+    if item[0] in "\"'[{":
+        raise ConfigError(f"The sweep assignment {text!r}: {item!r} is not a valid TOML value.")
+    try:
+        return float(item)
+    except ValueError:
+        return item
+
+
+def _check_key(key: str) -> None:
+    if not key:
+        raise ConfigError("A sweep key is empty; it is a dotted configuration key such as 'driver.sigma_theta'.")
+    if not _KEY.fullmatch(key):
+        raise ConfigError(f"The sweep key {key!r} is not a dotted configuration key such as "
+                          f"'driver.sigma_theta'.")
+    head = key.split(".")[0]
+    if head in _UNSWEEPABLE:
+        raise ConfigError(f"The sweep key {key!r} cannot be swept: {_UNSWEEPABLE[head]}.")
+
+
+def _check_distinct(key: str, values: Sequence[Any]) -> None:
+    if not values:
+        raise ConfigError(f"The sweep key {key!r} has no values.")
+    for k, v in enumerate(values):
+        # ==, so 1 and 1.0 (one value for pydantic) are refused too.
+        if v in values[:k]:
+            raise ConfigError(f"The sweep key {key!r} lists the value {v!r} twice.")
+
+
+# ---------------------------------------------------------------------------
+# the sweep
+
+
+def sweep(
+    config: Config | Mapping[str, Any] | str | Path,
+    grid: Mapping[str, Sequence[Any]],
+    *,
+    progress: bool | None = False,
+    on_realization: Callable[[int, int], None] | None = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> xr.Dataset:
+    """Run ``config`` at every point of the product ``grid`` and return one dataset.
+
+    See the module docstring for the rules on seeds, dimension names,
+    recorded times and layout.
+
+    Parameters
+    ----------
+    config : Config, dict or path
+        The base configuration (MODEL.md section 5); a path is read as TOML
+        (files it names are found next to it). It need not be valid by
+        itself, but every point must be.
+    grid : mapping of str to sequence
+        Dotted key (``"driver.sigma_theta"``) -> the values it takes, in
+        order. A value replaces the key's whole value; missing tables are
+        created.
+    progress : bool or None
+        Show one progress bar over the realizations of every point (None:
+        only on a terminal).
+    on_realization : callable, optional
+        Called as ``on_realization(i, r)`` once realization r of point i is
+        done, or found done on resume (i: the point's index in C order, as
+        in ``out/points/<i>``). Points come in order; the realizations of a
+        point, in the order they finish.
+    out : str or Path, optional
+        Output folder: ``out/sweep.json``, point i in ``out/points/<i>/``,
+        the result written atomically to ``out/result.nc``. A folder that
+        holds a sweep is refused unless ``resume``.
+    resume : bool
+        Continue the killed sweep in ``out``, point by point (same
+        configuration and grid; the seed stored there).
+    workers, scheduler
+        Passed to :func:`slidernet.run` for every point (where the
+        realizations run; never changes a result).
+
+    Returns
+    -------
+    xarray.Dataset
+        The points' variables with the sweep dimensions in front, e.g.
+        ``n`` (sigma_theta, realization, t) and ``r_mean`` (sigma_theta,);
+        attributes ``config`` (the base configuration as JSON, seed
+        resolved), ``sweep`` (the grid as JSON), ``configs`` (JSON list of
+        every point's resolved configuration, in C order),
+        ``slidernet_version``, ``seed``, ``kernel`` and ``execution`` (the
+        runner's, of the last point).
+
+    Raises
+    ------
+    ConfigError
+        Before any work, naming the point and its keys, if a point's
+        configuration is invalid or the points cannot be stacked.
+    CheckpointError
+        If ``out`` holds another sweep, or (on resume) none.
+    RunInterrupted
+        On Ctrl-C with ``out``, once the work done is saved; its message
+        says how to resume.
+
+    Examples
+    --------
+    >>> base = {"seed": 1, "realizations": 2, "steps": 50,
+    ...         "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...         "friction": {"mu_d": 0.5,
+    ...                      "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    ...         "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}
+    >>> ds = sweep(base, {"driver.sigma_theta": [1e-7, 1e-6]})
+    >>> ds["n"].dims, ds["r_mean"].dims
+    (('sigma_theta', 'realization', 't'), ('sigma_theta',))
+    >>> ds["sigma_theta"].values.tolist()
+    [1e-07, 1e-06]
+    >>> bool((ds["n"].sel(sigma_theta=1e-6) >= ds["n"].sel(sigma_theta=1e-7)).all())
+    True
+    """
+    grid = _checked_grid(grid)
+    base = _base_dict(config)
+    folder = None if out is None else Path(out)
+    identity = _identity(base, grid)
+    seed = base.get("seed")
+    if folder is not None:
+        stored_seed = _check_folder(folder, identity, resume)
+        seed = stored_seed if stored_seed is not None else seed
+    if seed is None:
+        # As runner.resolve_seed, once for the whole sweep: every point shares it.
+        seed = int(np.random.SeedSequence().entropy)
+    base = {**base, "seed": seed}
+    keys = list(grid)
+    shape = tuple(len(v) for v in grid.values())
+    points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
+    cfgs = [_point_config(base, assignment, i) for i, assignment in enumerate(points)]
+    t_common = _check_layout(cfgs, points)
+
+    if folder is not None and not resume:
+        with atomic_output(folder / _SWEEP_JSON) as tmp:
+            tmp.write_text(json.dumps({**identity, "seed": seed}, indent=1))
+    execution = {k: v for k, v in (("workers", workers), ("scheduler", scheduler)) if v is not None}
+    R = cfgs[0].realizations
+    bar = tqdm(total=len(cfgs) * R, desc="sweep", disable=None if progress is None else not progress)
+    results = []
+    try:
+        for i, cfg in enumerate(cfgs):
+            bar.set_postfix_str(_describe(points[i]))
+            done = _counter(bar, on_realization, i)
+            where = None if folder is None else folder / "points" / str(i)
+            results.append(_run_point(cfg, where, resume, done, execution))
+    except KeyboardInterrupt:
+        if folder is None:
+            raise
+        raise RunInterrupted(
+            f"interrupted: {len(results)} of {len(cfgs)} sweep points are done in {str(folder / 'points')!r} "
+            f"(and the saved work of point {len(results)}); continue with `slidernet sweep CONFIG --set ... "
+            f"--out {str(folder)!r} --resume` or sweep(config, grid, out=..., resume=True)."
+        ) from None
+    finally:
+        bar.close()
+
+    ds = _combine(results, keys, grid, shape, t_common)
+    ds.attrs = {
+        "config": json.dumps(base, sort_keys=True),
+        "sweep": json.dumps(grid),
+        "configs": json.dumps([json.loads(r.attrs["config"]) for r in results]),
+        "slidernet_version": slidernet.__version__,
+        "seed": str(seed),
+        "kernel": results[0].attrs["kernel"],
+        "Conventions": "CF-1.8",
+        "title": "slidernet sweep result",
+    }
+    if "execution" in results[-1].attrs:
+        ds.attrs["execution"] = results[-1].attrs["execution"]
+    if folder is not None:
+        write_netcdf(ds, folder / "result.nc")
+    return ds
+
+
+_SWEEP_JSON = "sweep.json"
+
+
+def _identity(base: dict[str, Any], grid: dict[str, list[Any]]) -> dict[str, Any]:
+    """What a sweep folder must match to be resumed (JSON-normalized: tuples are lists)."""
+    return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": slidernet.__version__}))
+
+
+def _check_folder(folder: Path, identity: dict[str, Any], resume: bool) -> int | None:
+    """Refuse a folder that holds another sweep (or none, on resume); return the stored seed on resume."""
+    path = folder / _SWEEP_JSON
+    if not resume:
+        if path.exists():
+            raise CheckpointError(f"{str(folder)!r} holds a sweep already. Continue it with --resume "
+                                  f"(resume=True), or use another output directory.")
+        return None
+    if not path.exists():
+        raise CheckpointError(f"Nothing to resume in {str(folder)!r}: it has no {_SWEEP_JSON}.")
+    try:
+        stored = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise CheckpointError(f"The sweep file {str(path)!r} cannot be read: {exc}") from None
+    for what, name in (("config", "base configuration"), ("sweep", "grid"),
+                       ("slidernet_version", "slidernet version")):
+        if stored.get(what) != identity[what]:
+            raise CheckpointError(
+                f"Cannot resume: the {name} differs from that of the sweep in {str(folder)!r} "
+                f"({json.dumps(stored.get(what))} there, {json.dumps(identity[what])} now). Resume with the "
+                f"same configuration and grid, or use another output directory.")
+    return int(stored["seed"])
+
+
+def _run_point(cfg: Config, where: Path | None, resume: bool, done: Callable[[int], None],
+               execution: dict[str, Any]) -> xr.Dataset:
+    """One point: a plain run, or its run in ``where`` (resumed, or read back if it has finished)."""
+    if where is None:
+        return runner.run(cfg, progress=False, on_realization=done, **execution)
+    # slidernet.store keeps a run's checkpoint folder until its result.nc is written.
+    unfinished = (where / "checkpoint").exists()
+    if resume and not unfinished and (where / "result.nc").exists():
+        ds = read_result(where / "result.nc")
+        expected = json.loads(json.dumps(cfg.model_dump(mode="json", exclude={"execution"})))
+        if json.loads(ds.attrs["config"]) != expected:
+            raise CheckpointError(f"Cannot resume: {str(where / 'result.nc')!r} holds a run of another "
+                                  f"configuration than this point's.")
+        for r in range(cfg.realizations):
+            done(r)
+        return ds
+    ds = runner.run(cfg, progress=False, on_realization=done, out=where, resume=resume and unfinished,
+                    **execution)
+    # The runner opens its result file lazily: read it and let the file go.
+    ds.load()
+    ds.close()
+    return ds
+
+
+def _counter(bar: tqdm, on_realization: Callable[[int, int], None] | None, i: int) -> Callable[[int], None]:
+    def done(r: int) -> None:
+        bar.update(1)
+        if on_realization is not None:
+            on_realization(i, r)
+    return done
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as plain JSON-like Python: dicts, lists, str, int, float, bool, None."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def _checked_grid(grid: Mapping[str, Sequence[Any]]) -> dict[str, list[Any]]:
+    if not isinstance(grid, Mapping) or not grid:
+        raise ConfigError("A sweep needs at least one key with its values, e.g. "
+                          "{'driver.sigma_theta': [1e-7, 1e-6]}.")
+    checked: dict[str, list[Any]] = {}
+    for key, values in grid.items():
+        _check_key(key)
+        if isinstance(values, (str, bytes, Mapping)) or not isinstance(values, (Sequence, np.ndarray)):
+            raise ConfigError(f"The sweep key {key!r} must map to a sequence of values; got {values!r}.")
+        values = [_plain(v) for v in values]
+        _check_distinct(key, values)
+        checked[key] = values
+    for a, b in itertools.permutations(checked, 2):
+        if b.startswith(a + "."):
+            raise ConfigError(f"The sweep keys {a!r} and {b!r} overlap: the first replaces the table of "
+                              f"the second.")
+    return checked
+
+
+def _base_dict(config: Config | Mapping[str, Any] | str | Path) -> dict[str, Any]:
+    """The base configuration as a plain dict, as the user wrote it (defaults not filled in)."""
+    if isinstance(config, Config):
+        return _plain(config.model_dump(mode="json", exclude_unset=True))
+    if isinstance(config, Mapping):
+        return _plain(copy.deepcopy(dict(config)))
+    if isinstance(config, (str, Path)):
+        path = Path(config)
+        try:
+            with path.open("rb") as fh:
+                raw = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+        # As load_config (the base need not be valid, so it cannot be loaded): files
+        # named in a config file are found next to that file.
+        friction = raw.get("friction")
+        static = friction.get("static") if isinstance(friction, dict) else None
+        for table in (raw.get("network"), raw.get("driver"), static):
+            if isinstance(table, dict) and isinstance(table.get("path"), str) \
+                    and not Path(table["path"]).is_absolute():
+                table["path"] = str(path.parent / table["path"])
+        return _plain(raw)
+    raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(config).__name__}.")
+
+
+def _describe(assignment: Mapping[str, Any]) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in assignment.items())
+
+
+def _point_config(base: Mapping[str, Any], assignment: Mapping[str, Any], i: int) -> Config:
+    data = copy.deepcopy(dict(base))
+    for key, value in assignment.items():
+        *parents, last = key.split(".")
+        table = data
+        for depth, part in enumerate(parents):
+            table = table.setdefault(part, {})
+            if not isinstance(table, dict):
+                where = ".".join(parents[:depth + 1])
+                raise ConfigError(f"Sweep point {i} ({_describe(assignment)}): the sweep key {key!r} "
+                                  f"needs {where!r} to be a table; it is {table!r}.")
+        table[last] = copy.deepcopy(value)
+    try:
+        return load_config(data)
+    except ConfigError as exc:
+        raise ConfigError(f"Sweep point {i} ({_describe(assignment)}): {exc}") from None
+
+
+def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarray:
+    """Refuse points that cannot be stacked; return the shared recorded times."""
+    def refuse(i: int, j: int, why: str) -> ConfigError:
+        return ConfigError(f"Sweep points {i} ({_describe(points[i])}) and {j} ({_describe(points[j])}) "
+                           f"cannot be stacked: {why}")
+
+    times = [record_times(c.steps, c.record, c.log_points_per_decade) for c in cfgs]
+    shortest = min(range(len(cfgs)), key=lambda i: cfgs[i].steps)
+    t_common = times[shortest]
+    scenes: dict[str, tuple[str, int, int]] = {}
+    for i, c in enumerate(cfgs):
+        if "events" in c.observables:
+            raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the 'events' observable (the event "
+                              f"catalogue, whose length differs from run to run) cannot be swept; run the "
+                              f"points one by one with slidernet.run.")
+        if not np.array_equal(times[i][:t_common.size], t_common):
+            raise refuse(shortest, i, f"the points are stacked along t, so the recorded times of point {i} must "
+                         f"begin with those of point {shortest} (the fewest steps); to sweep 'steps', record "
+                         f"'all', an explicit list of times that holds every smaller 'steps', or 'log' with "
+                         f"'steps' whole decades apart")
+        if c.realizations != cfgs[0].realizations:
+            raise refuse(0, i, f"{cfgs[0].realizations} and {c.realizations} realizations")
+        if set(c.observables) != set(cfgs[0].observables):
+            raise refuse(0, i, f"observables {sorted(cfgs[0].observables)} and {sorted(c.observables)}")
+        # What decides the variables and their shapes; the scene is built once per distinct one.
+        what = json.dumps(c.model_dump(mode="json", include={"network", "solver", "observables", "mu_eff_at"}),
+                          sort_keys=True)
+        if what not in scenes:
+            try:
+                scene = Scene.from_config(c)
+            except ConfigError as exc:
+                raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): {exc}") from None
+            scenes[what] = (scene.kernel, scene.network.dim, scene.network.n_nodes)
+        first = next(iter(scenes.values()))
+        if scenes[what] != first:
+            (k0, d0, n0), (k1, d1, n1) = first, scenes[what]
+            raise refuse(0, i, f"their scenes differ (kernel {k0!r}, {d0}D, {n0} nodes against kernel "
+                         f"{k1!r}, {d1}D, {n1} nodes), and so do their variables")
+    return t_common
+
+
+def _dim_names(keys: list[str], taken: set[str]) -> list[str]:
+    last = [k.rsplit(".", 1)[-1] for k in keys]
+    return [name if last.count(name) == 1 and name not in taken else key for key, name in zip(keys, last,
+                                                                                                strict=True)]
+
+
+def _coordinate(values: list[Any]) -> np.ndarray:
+    """The values as a netCDF-friendly 1D array: numbers, booleans, strings, else JSON text."""
+    if all(isinstance(v, bool) for v in values):
+        return np.array(values, dtype=bool)
+    if all(isinstance(v, Number) and not isinstance(v, bool) for v in values):
+        return np.array(values)
+    if all(isinstance(v, str) for v in values):
+        return np.array(values, dtype=str)
+    return np.array([json.dumps(v, sort_keys=True) for v in values], dtype=str)
+
+
+def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list[Any]], shape: tuple[int, ...],
+             t_common: np.ndarray) -> xr.Dataset:
+    """Stack the points' datasets (C order) along the sweep dimensions."""
+    results = [r.isel(t=slice(0, t_common.size)) if "t" in r.dims else r for r in results]
+    first = results[0]
+    for i, r in enumerate(results[1:], start=1):
+        # _check_layout makes this hold; a mismatch here is a bug, never a NaN in the result.
+        same_vars = {n: v.dims for n, v in r.data_vars.items()} == {n: v.dims for n, v in first.data_vars.items()}
+        if not same_vars or not r.coords.equals(first.coords):
+            raise ConfigError(f"Sweep point {i} gave a dataset laid out unlike point 0's; it cannot be stacked.")
+    dims = _dim_names(keys, set(first.variables) | set(first.dims))
+    ds = xr.Dataset(coords={dim: (dim, _coordinate(grid[key]), {"long_name": f"swept configuration value {key!r}",
+                                                                "sweep_key": key})
+                            for dim, key in zip(dims, keys, strict=True)})
+    ds = ds.assign_coords(first.coords)
+    for name, var in first.data_vars.items():
+        data = np.stack([r[name].values for r in results]).reshape(shape + var.shape)
+        ds[name] = ((*dims, *var.dims), data, dict(var.attrs))
+    return ds
