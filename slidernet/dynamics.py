@@ -1,0 +1,448 @@
+"""A reference integrator of the equations of motion (eq. `dynamics`), to measure the quasi-static error.
+
+The solver (:mod:`slidernet.solver`) makes every slip instantaneous and lets
+the slipping node move alone. Here the sliders have inertia: node i has mass
+m_i = N_i m, and while it moves
+
+    m_i d^2u_i/dt^2 = F_i(u, theta(t)) - mu_d N_i S(du_i/dt),    F = -K u + theta g + f_ext,
+
+with theta(t) linear between theta(t_q) and theta(t_q+1), the same driver
+values as the solver's. A stuck node has du_i/dt = 0 while |F_i| <= mu_s,i N_i
+and starts, with the sign of F_i, when |F_i| reaches mu_s,i N_i, whatever the
+other nodes do: several nodes may move at once. A moving node whose velocity
+returns to zero has reached a new place on the substrate: its threshold is
+redrawn, and it sticks if |F_i| <= mu_s,i N_i, otherwise it starts again (a
+new rearrangement, as in the solver's 1D rule). One rearrangement is counted
+per start of motion.
+
+The one time scale of the motion is tau_dyn = sqrt(m / k) for the reference
+spring (k = 1 in the solver's units), and the one parameter is
+``tau_ratio = tau_dyn / tau_th``. For the two sliders with theta frozen, a slip
+is a half-oscillation of duration pi tau_dyn and length 2 (mu_s - mu_d) N / k
+(eq. `displacement`): the solver's slip is the limit tau_ratio -> 0.
+
+Units are the solver's: u in Ntilde l0, theta / Ntilde, forces in N, K in
+k0 = N / (Ntilde l0), time in tau_th; during motion the integration runs in
+the local time s = (t - t_0) / tau_dyn, in which the equation of node i reads
+N_i d^2u_i/ds^2 = F_i - mu_d N_i S(du_i/ds) and every number is of order one.
+
+How it is integrated
+--------------------
+Between two events the set of moving nodes and the signs of their velocities
+are fixed and theta is linear in time, so the equations are linear with a
+smooth right-hand side: each such phase is one call of
+:func:`scipy.integrate.solve_ivp` with two terminal events, the smallest
+velocity of a moving node (along its direction of motion) falling to zero,
+and the largest |F_j| - mu_s,j N_j of the stuck nodes rising to zero. A phase
+where nothing moves has u constant and F_j linear in t, so its first threshold
+crossing is found in closed form (the solver's eq. `critique`), with no steps.
+
+Cost: about 21 ms per slip at the defaults (DOP853, max_step = 0.05 tau_dyn,
+~66 steps per slip), 15 ms with RK45, 7 ms at max_step = 0.2 and 4 ms at
+max_step = inf, on the paper's two sliders and on a chain of 4 alike (577 and
+160 slips, tau_ratio = 1e-4, one core): the time is scipy's, per step.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from slidernet.errors import AvalancheError, ConfigError, param_error
+from slidernet.solver import Scene, horizontal_draws, realization_streams
+
+METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+# A node that slides this long (in tau_dyn) without its velocity ever returning
+# to zero is sliding for ever: a single slip of the paper lasts pi tau_dyn.
+MAX_SLIP_DURATION = 1000.0
+
+# atol = ATOL_SCALE * rtol, in Ntilde l0 (and Ntilde l0 per tau_dyn): a slip of
+# the paper is 2 (mu_s - mu_d) ~ 0.2 Ntilde l0 long, its peak velocity ~ 0.1.
+ATOL_SCALE = 1e-2
+
+
+class ThresholdStream:
+    """A realization's thresholds in the order the solver reads them.
+
+    Parameters
+    ----------
+    initial : ndarray, shape (N,)
+        The initial mu_s of the nodes.
+    batches : iterator of ndarray
+        The replacement draws, in batches of ``scene.batch``
+        (:func:`slidernet.solver.horizontal_draws`); :meth:`next` reads them
+        one by one.
+    """
+
+    def __init__(self, initial: np.ndarray, batches: Iterator[np.ndarray]) -> None:
+        self.initial = initial
+        self.batches = batches
+        self.buf = np.empty(0)
+        self.pos = 0
+
+    def next(self) -> float:
+        """The next replacement threshold."""
+        if self.pos >= self.buf.size:
+            self.buf = next(self.batches)
+            self.pos = 0
+        value = float(self.buf[self.pos])
+        self.pos += 1
+        return value
+
+
+def realization_draws(scene: Scene, seed_seq: np.random.SeedSequence) -> tuple[np.ndarray, ThresholdStream]:
+    """theta(t_q) / Ntilde, shape (steps + 1,), and the thresholds of one realization, as the solver draws them."""
+    thetas, mu, batches = horizontal_draws(scene, realization_streams(seed_seq))
+    return thetas, ThresholdStream(mu, batches)
+
+
+class Dynamics:
+    """Reference integrator of the equations of motion (eq. `dynamics`) on a 1D network.
+
+    Constructing it validates and stores the settings; :meth:`run` integrates
+    one realization, with the same theta(t_q) and the same stream of mu_s
+    draws as :func:`slidernet.solver.simulate` on the same seed.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene of a 1D network (``two_slider``, ``chain`` or any 1D
+        :class:`~slidernet.network.Network`), with its f_ext, normal loads,
+        thresholds law and driver.
+    tau_ratio : float
+        tau_dyn / tau_th, > 0, with tau_dyn = sqrt(m / k) the period of the
+        reference spring divided by 2 pi (masses m_i = N_i m).
+    max_step : float
+        Largest integration step during motion, in units of tau_dyn, > 0
+        (``inf``: the step is set by ``rtol`` alone). Events are seen at the
+        ends of steps only, so a velocity that dips to zero and comes back
+        within one step (a node pushed on by a neighbour) is missed: on a
+        chain of 4 (sigma_theta / Ntilde = 3, tau_ratio = 1e-4, seeds 0 and 1,
+        10 steps) the slips at 0.2 and 1 tau_dyn departed from those at 0.01
+        after 217 to 280 slips, those at 0.05 did not.
+    rtol : float
+        Relative tolerance of :func:`scipy.integrate.solve_ivp`, in
+        [100 eps, 1); the absolute tolerance is ``1e-2 * rtol`` in Ntilde l0.
+    method : str
+        A :func:`scipy.integrate.solve_ivp` method (default ``"DOP853"``).
+
+    Examples
+    --------
+    The paper's two sliders on a slow ramp of theta: the first slip is that of
+    the weaker slider, 2 (mu_s - mu_d) Ntilde l0 long and pi tau_dyn in
+    duration (eq. `displacement`), and the counts are the solver's.
+
+    >>> from slidernet.config import load_config
+    >>> from slidernet.solver import Realization, simulate
+    >>> scene = Scene.from_config(load_config({
+    ...     "steps": 2, "record": "all", "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...     "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    ...     "driver": {"name": "ramp", "rate": 1e-7}}))
+    >>> out = Dynamics(scene, tau_ratio=1e-6).run(np.random.SeedSequence(0))
+    >>> out["n"].tolist(), simulate(scene, np.random.SeedSequence(0))["n"].tolist()
+    ([0, 3, 8], [0, 3, 8])
+    >>> mu = Realization(scene, np.random.SeedSequence(0)).mu
+    >>> slip = {key: value[0] for key, value in out["slips"].items()}
+    >>> int(slip["node"]), int(np.argmin(mu))
+    (1, 1)
+    >>> print(f"{slip['du'] / (2 * (mu.min() - 0.5) * 1e-7):.4f}, {slip['duration'] / (np.pi * 1e-6):.4f}")
+    1.0000, 1.0000
+    """
+
+    def __init__(self, scene: Scene, tau_ratio: float, max_step: float = 0.05, rtol: float = 1e-8,
+                 method: str = "DOP853") -> None:
+        owner = "Dynamics"
+        if isinstance(tau_ratio, bool) or not isinstance(tau_ratio, (int, float)) or not (
+                math.isfinite(tau_ratio) and tau_ratio > 0):
+            raise param_error("tau_ratio", owner, "a finite number > 0", tau_ratio)
+        if isinstance(max_step, bool) or not isinstance(max_step, (int, float)) or not max_step > 0:
+            raise param_error("max_step", owner, "a number > 0 (inf: no limit)", max_step)
+        floor = 100 * np.finfo(float).eps
+        if isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not floor <= rtol < 1:
+            raise param_error("rtol", owner, f"a number in [{floor:.3g}, 1) (scipy's floor is 100 eps)", rtol)
+        if method not in METHODS:
+            raise param_error("method", owner, f"one of {', '.join(METHODS)}", method)
+        net = scene.network
+        if net.dim != 1:
+            raise ConfigError(
+                f"Dynamics integrates 1D networks only; the scene's network is {net.dim}D "
+                f"({net!r}). Compare 2D networks through the solver's slip options (solver.slip)."
+            )
+        self.scene = scene
+        self.tau_ratio = float(tau_ratio)
+        self.max_step = float(max_step)
+        self.rtol = float(rtol)
+        self.atol = ATOL_SCALE * self.rtol
+        self.method = method
+        # Dense operators: the networks integrated here are small (N <= ~16),
+        # and a dense sub-block product is the cheapest right-hand side.
+        self.K = net.stiffness_matrix().toarray()
+        self.g = np.asarray(scene.ops["g"], dtype=np.float64)
+        self.normal_load = net.normal_load.astype(np.float64)
+        self.w = self.normal_load / self.normal_load.sum()
+        self.f_ext = net.f_ext[:, 0].astype(np.float64)
+
+    def run(self, seed_seq: np.random.SeedSequence, steps: int | None = None) -> dict[str, np.ndarray]:
+        """Integrate one realization through ``steps`` thermal steps (default: the scene's).
+
+        Parameters
+        ----------
+        seed_seq : numpy.random.SeedSequence
+            The realization's seed, as given to :func:`slidernet.solver.simulate`.
+        steps : int, optional
+            Thermal steps to run, 0 <= steps <= ``scene.steps``; theta(t_q) is
+            drawn for the scene's steps either way (the same draws).
+
+        Returns
+        -------
+        dict
+            ``t`` (int64, tau_th), ``n`` (int64: rearrangements, one per
+            start of motion), ``mu_max``, ``x_G`` (l0, the mass-weighted mean
+            displacement), each of shape (T,), at the scene's recorded times
+            up to ``steps``; ``overlapping`` (int64 scalar: starts while another
+            node was moving); ``moving_at_end`` (int64 scalar: nodes still
+            moving at t = steps); ``slips``, a dict of arrays of shape (S,),
+            one per slip that came to rest by t = ``steps``, in the order they
+            ended: ``start`` and ``end`` (tau_th), ``duration`` (tau_th,
+            computed in the integrator's local time, so exact even where
+            ``start`` is large), ``node`` (int64), ``du`` (l0).
+        """
+        sc = self.scene
+        steps = sc.steps if steps is None else steps
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= sc.steps:
+            raise param_error("steps", "Dynamics.run", f"an integer in [0, {sc.steps}]", steps)
+        thetas, draws = realization_draws(sc, seed_seq)
+        return _Realization(self, thetas, draws).run(int(steps))
+
+
+class _Realization:
+    """The state of one integrated realization and its event loop.
+
+    Attributes: ``u`` (N,) displacements in Ntilde l0; ``v`` (N,) velocities
+    in Ntilde l0 per tau_dyn; ``moving`` (N,) bool; ``sigma`` (N,) the sign of
+    the motion of each moving node; ``t`` the time in tau_th; ``clock`` the
+    time spent in motion, in tau_dyn (it also runs during the relaxation at
+    t = 0, where theta is frozen).
+    """
+
+    def __init__(self, dyn: Dynamics, thetas: np.ndarray, draws: ThresholdStream) -> None:
+        self.d = dyn
+        self.thetas = thetas
+        self.draws = draws
+        N = dyn.normal_load.size
+        self.mu = draws.initial.copy()
+        self.lim = self.mu * dyn.normal_load
+        self.u = np.zeros(N)
+        self.v = np.zeros(N)
+        self.moving = np.zeros(N, bool)
+        self.sigma = np.zeros(N)
+        self.t = 0.0
+        self.clock = 0.0
+        self.n = 0
+        self.overlapping = 0
+        self.start_t = np.zeros(N)
+        self.start_clock = np.zeros(N)
+        self.start_u = np.zeros(N)
+        self.slips: list[tuple[float, float, float, int, float]] = []
+
+    def forces(self, theta: float) -> np.ndarray:
+        """F = -K u + (theta - theta(0)) g + f_ext, in N, shape (N,); theta in units of Ntilde.
+
+        u = 0 is every spring at rest at theta(0), as in the solver (a = -g theta(0)).
+        """
+        d = self.d
+        return d.f_ext - d.K @ self.u + d.g * (theta - self.thetas[0])
+
+    def run(self, steps: int) -> dict[str, np.ndarray]:
+        d, thetas = self.d, self.thetas
+        rec = d.scene.rec_times[d.scene.rec_times <= steps]
+        out_n = np.zeros(rec.size, np.int64)
+        out_mu_max = np.zeros(rec.size)
+        out_xg = np.zeros(rec.size)
+        # An f_ext above some thresholds is relaxed with theta frozen at
+        # theta(0), before the t = 0 record, as the solver does.
+        self._start_overloaded(thetas[0])
+        while self.moving.any():
+            s1, kind = self._move(thetas[0], 0.0, MAX_SLIP_DURATION)
+            self._after_move(s1, kind, thetas[0])
+        k = 0
+        for q in range(steps + 1):
+            if k < rec.size and rec[k] == q:
+                out_n[k] = self.n
+                out_mu_max[k] = self.mu.max()
+                out_xg[k] = d.w @ self.u
+                k += 1
+            if q == steps:
+                break
+            self._segment(q, thetas[q], thetas[q + 1])
+        Ntilde = d.scene.network.Ntilde
+        slips = np.array(self.slips, dtype=float).reshape(-1, 5)
+        return {
+            "t": rec.astype(np.int64),
+            "n": out_n,
+            "mu_max": out_mu_max,
+            "x_G": out_xg * Ntilde,
+            "overlapping": np.int64(self.overlapping),
+            "moving_at_end": np.int64(self.moving.sum()),
+            "slips": {
+                "start": slips[:, 0].copy(),
+                "end": slips[:, 1].copy(),
+                "duration": slips[:, 2].copy(),
+                "node": slips[:, 3].astype(np.int64),
+                "du": slips[:, 4] * Ntilde,
+            },
+        }
+
+    def _segment(self, q: int, theta_a: float, theta_b: float) -> None:
+        """From t = q to t = q + 1, theta linear from ``theta_a`` to ``theta_b`` (units of Ntilde)."""
+        rate = theta_b - theta_a  # per tau_th
+        tau = self.d.tau_ratio
+        while True:
+            theta = theta_a + rate * (self.t - q)
+            if self.moving.any():
+                left = (q + 1 - self.t) / tau
+                s1, kind = self._move(theta, rate * tau, min(left, MAX_SLIP_DURATION))
+                if kind is None and s1 >= left:
+                    break
+                self.t += tau * s1
+                self._after_move(s1, kind, theta_a + rate * (self.t - q))
+            else:
+                # Nothing moves: u is constant and F_j(t) = F_j + g_j rate (t - t_now),
+                # so the next start is the first root of |F_j| = mu_s,j N_j (eq. `critique`).
+                drive = self.d.g * rate
+                driven = np.flatnonzero(drive)
+                if driven.size == 0:
+                    break
+                F = self.forces(theta)[driven]
+                sgn = np.sign(drive[driven])
+                wait = np.maximum((self.lim[driven] - sgn * F) / np.abs(drive[driven]), 0.0)
+                j = int(np.argmin(wait))
+                # Inclusive at the end of the segment, as the solver's eq. `critique`.
+                if self.t + wait[j] > q + 1:
+                    break
+                self.t += wait[j]
+                self._start(int(driven[j]), sgn[j])
+                self._start_overloaded(theta_a + rate * (self.t - q))
+        self.t = float(q + 1)
+
+    def _start(self, i: int, sign: float) -> None:
+        """Node i starts moving with the sign ``sign``: one rearrangement."""
+        if self.moving.any():
+            self.overlapping += 1
+        self.n += 1
+        self.moving[i] = True
+        self.sigma[i] = sign
+        self.v[i] = 0.0
+        self.start_t[i] = self.t
+        self.start_clock[i] = self.clock
+        self.start_u[i] = self.u[i]
+
+    def _start_overloaded(self, theta: float) -> None:
+        """Start every stuck node above its threshold, the largest overload first."""
+        while True:
+            F = self.forces(theta)
+            over = np.where(self.moving, 0.0, np.abs(F) / self.lim)
+            i = int(np.argmax(over))
+            if over[i] <= 1.0:
+                return
+            self._start(i, 1.0 if F[i] > 0.0 else -1.0)
+
+    def _move(self, theta0: float, rate_s: float, s_max: float) -> tuple[float, str | None]:
+        """Integrate the moving nodes from local time s = 0 to the first event or to ``s_max``.
+
+        theta(s) = theta0 + rate_s s (units of Ntilde; s in tau_dyn). Updates
+        u and v of the moving nodes and ``clock``; returns the time elapsed
+        (tau_dyn) and the event, ``"stop"``, ``"start"`` or None.
+        """
+        d = self.d
+        M = np.flatnonzero(self.moving)
+        S = np.flatnonzero(~self.moving)
+        m = M.size
+        F0 = self.forces(theta0)
+        Nm = d.normal_load[M]
+        sig = self.sigma[M]
+        # y = (u_M - u_M(0), du_M/ds) obeys y' = A y + c s + b; with z = (y, s, 1)
+        # that is one product y' = B z, half the cost of three array operations.
+        B = np.zeros((2 * m, 2 * m + 2))
+        B[:m, m:2 * m] = np.eye(m)
+        B[m:, :m] = -d.K[np.ix_(M, M)] / Nm[:, None]
+        B[m:, 2 * m] = d.g[M] * rate_s / Nm
+        B[m:, 2 * m + 1] = (F0[M] - d.scene.mu_d * Nm * sig) / Nm
+        z = np.zeros(2 * m + 2)
+        z[-1] = 1.0
+
+        def rhs(s: float, y: np.ndarray) -> np.ndarray:
+            z[:-2] = y
+            z[-2] = s
+            return B @ z
+
+        def stop(s: float, y: np.ndarray) -> float:
+            # A node that starts at s = 0 has zero velocity there: a placeholder > 0 at s = 0 keeps
+            # the root finder from stopping it at once when another node stops within the first step.
+            if s == 0.0:
+                return 1.0
+            return float((sig * y[m:]).min())
+
+        stop.terminal = True
+        stop.direction = -1.0
+        events = [stop]
+        if S.size:
+            K_SM = d.K[np.ix_(S, M)]
+            F0_S = F0[S]
+            g_S = d.g[S] * rate_s
+            lim_S = self.lim[S]
+
+            def start(s: float, y: np.ndarray) -> float:
+                return float((np.abs(F0_S - K_SM @ y[:m] + g_S * s) - lim_S).max())
+
+            start.terminal = True
+            start.direction = 1.0
+            events.append(start)
+        y0 = np.concatenate([np.zeros(m), self.v[M]])
+        sol = solve_ivp(rhs, (0.0, s_max), y0, method=d.method, rtol=d.rtol, atol=d.atol,
+                        max_step=d.max_step, events=events)
+        if sol.status == -1:  # pragma: no cover - a linear right-hand side does not fail
+            raise RuntimeError(f"solve_ivp failed at t = {self.t} tau_th: {sol.message}")
+        s1 = float(sol.t[-1])
+        y1 = sol.y[:, -1]
+        self.u[M] += y1[:m]
+        self.v[M] = y1[m:]
+        self.clock += s1
+        kind = None
+        if sol.status == 1:
+            kind = "stop" if sol.t_events[0].size else "start"
+        return s1, kind
+
+    def _after_move(self, s1: float, kind: str | None, theta: float) -> None:
+        """Apply the event that ended a phase (``self.t`` and u already at its time)."""
+        d = self.d
+        if kind == "stop":
+            M = np.flatnonzero(self.moving)
+            i = int(M[np.argmin(self.sigma[M] * self.v[M])])
+            self.moving[i] = False
+            self.v[i] = 0.0
+            self.slips.append((self.start_t[i], self.t, (self.clock - self.start_clock[i]) * d.tau_ratio, i,
+                               self.u[i] - self.start_u[i]))
+            # A new place on the substrate: a new threshold.
+            self.mu[i] = self.draws.next()
+            self.lim[i] = self.mu[i] * d.normal_load[i]
+        elif kind == "start":
+            F = self.forces(theta)
+            S = np.flatnonzero(~self.moving)
+            j = int(S[np.argmax(np.abs(F[S]) - self.lim[S])])
+            self._start(j, 1.0 if F[j] > 0.0 else -1.0)
+        # A stopped node above its new threshold starts again, and a node that
+        # the event left above its threshold (a tie) starts too.
+        self._start_overloaded(theta)
+        longest = self.clock - self.start_clock[self.moving]
+        if longest.size and longest.max() >= MAX_SLIP_DURATION:
+            i = int(np.flatnonzero(self.moving)[np.argmax(longest)])
+            raise AvalancheError(
+                f"Node {i} has been sliding for {MAX_SLIP_DURATION:g} tau_dyn without stopping "
+                f"(t = {self.t!r} tau_th): a load f_ext that friction cannot hold makes the network slide "
+                "for ever; lower f_ext."
+            )
