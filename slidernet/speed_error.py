@@ -273,31 +273,37 @@ def write_csv(table: list[Row], path: str | Path) -> Path:
     return Path(path)
 
 
-FLOOR = 1e-16  # where an exact (zero) error is drawn on the log axis
-
-
 def plot(table: list[Row], path: str | Path) -> Path:
-    """Error against seconds, log-log, one line per method; exact methods sit on the floor."""
+    """Error against seconds, log-log, one line per method, its settings in the order run.
+
+    Exact methods (error 0) are drawn as markers on a floor one decade below
+    the smallest error measured, labelled "exact".
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    methods = list(dict.fromkeys(r.method for r in table))
+    nonzero = [r.error for r in table if r.error > 0]
+    floor = 10.0 ** (math.floor(math.log10(min(nonzero))) - 1) if nonzero else 1e-16
     markers = "osD^v<>p"
-    for j, method in enumerate(methods):
+    for j, method in enumerate(dict.fromkeys(r.method for r in table)):
         sel = [r for r in table if r.method == method]
-        sel.sort(key=lambda r: r.seconds)
-        x = [r.seconds for r in sel]
-        y = [max(r.error, FLOOR) for r in sel]
-        ax.loglog(x, y, marker=markers[j % len(markers)], label=method)
-    ax.axhline(FLOOR, color="0.6", lw=0.8, ls=":")
-    ax.annotate("exact (error 0)", (ax.get_xlim()[0], FLOOR), xytext=(4, 4), textcoords="offset points",
-                fontsize=8, color="0.4")
+        approx = [r for r in sel if r.error > 0]
+        exact = [r for r in sel if r.error == 0]
+        style = {"marker": markers[j % len(markers)], "color": f"C{j}"}
+        if approx:
+            ax.loglog([r.seconds for r in approx], [r.error for r in approx], label=method, **style)
+        if exact:
+            ax.loglog([r.seconds for r in exact], [floor] * len(exact), ls="none", mfc="none",
+                      label=None if approx else method, **style)
+    ax.axhline(floor, color="0.6", lw=0.8, ls=":")
+    ax.annotate("exact (error 0)", (0.01, floor), xycoords=("axes fraction", "data"), xytext=(0, 4),
+                textcoords="offset points", fontsize=8, color="0.4")
     ax.set_xlabel("wall time on its scene [s]")
     ax.set_ylabel("relative error at the end (largest of n, mu_max, x_G)")
-    ax.set_title("speed against error, same realizations")
+    ax.set_title("speed against error, on the same realizations")
     ax.legend(fontsize=8)
     return save_figure(fig, path, dpi=120)
 
