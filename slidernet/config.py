@@ -459,6 +459,30 @@ def _describe(err: Mapping[str, Any]) -> str:
     return f"The {loc!r} field: {err['msg']}. Got {got!r} instead."
 
 
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """A configuration file as a dict, not validated; relative file paths made relative to the file.
+
+    Files named in a config file (a graph, a temperature series, measured
+    thresholds) are found next to that file.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            source = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+    friction = source.get("friction")
+    static = friction.get("static") if isinstance(friction, dict) else None
+    for table in (source.get("network"), source.get("driver"), static):
+        if isinstance(table, dict) and isinstance(table.get("path"), str):
+            named = Path(table["path"])
+            if not named.is_absolute():
+                table["path"] = str(path.parent / named)
+    return source
+
+
 def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     """Validate a configuration and build its plugins.
 
@@ -479,22 +503,7 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
         On any invalid field; the message names the field and the reason.
     """
     if isinstance(source, (str, Path)):
-        path = Path(source)
-        try:
-            with path.open("rb") as fh:
-                source = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
-        # Files named in a config file (a graph, a temperature series, measured
-        # thresholds) are found next to that file.
-        tables = (source.get("network"), source.get("driver"), (source.get("friction") or {}).get("static"))
-        for table in tables:
-            if isinstance(table, dict) and isinstance(table.get("path"), str):
-                named = Path(table["path"])
-                if not named.is_absolute():
-                    table["path"] = str(path.parent / named)
+        source = read_toml(source)
     if isinstance(source, Config):
         cfg = source
     else:

@@ -154,7 +154,7 @@ def run(
                 records[r] = rec
             else:
                 store.add(r, rec)
-                if time.monotonic() - last_flush >= ex.checkpoint_every or len(store._buffer) >= CHUNK:
+                if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
                     store.flush()
                     last_flush = time.monotonic()
             bar.update()

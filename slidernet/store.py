@@ -130,6 +130,11 @@ class RunStore:
         """Hold a finished realization until the next :meth:`flush`."""
         self._buffer[r] = record
 
+    @property
+    def held(self) -> int:
+        """Finished realizations held in memory, not yet written."""
+        return len(self._buffer)
+
     def flush(self) -> None:
         """Write the held realizations as one block, then drop their partial files."""
         if not self._buffer:

@@ -71,7 +71,7 @@ from tqdm.auto import tqdm
 
 import slidernet
 from slidernet import runner
-from slidernet.config import Config, load_config
+from slidernet.config import Config, load_config, read_toml
 from slidernet.errors import CheckpointError, ConfigError, RunInterrupted
 from slidernet.io import atomic_output, read_result, write_netcdf
 from slidernet.solver import Scene, record_times
@@ -479,22 +479,7 @@ def _base_dict(config: Config | Mapping[str, Any] | str | Path) -> dict[str, Any
     if isinstance(config, Mapping):
         return _plain(copy.deepcopy(dict(config)))
     if isinstance(config, (str, Path)):
-        path = Path(config)
-        try:
-            with path.open("rb") as fh:
-                raw = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
-        # As load_config (the base need not be valid, so it cannot be loaded): files
-        # named in a config file are found next to that file.
-        friction = raw.get("friction")
-        static = friction.get("static") if isinstance(friction, dict) else None
-        for table in (raw.get("network"), raw.get("driver"), static):
-            if isinstance(table, dict) and isinstance(table.get("path"), str) \
-                    and not Path(table["path"]).is_absolute():
-                table["path"] = str(path.parent / table["path"])
+        raw = read_toml(config)  # the base need not be valid, so it is read, not loaded
         return _plain(raw)
     raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(config).__name__}.")
 
