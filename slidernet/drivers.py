@@ -33,9 +33,9 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
-from numba import njit
 
 from slidernet.errors import ConfigError, param_error
+from slidernet.kernels.state import cached_jit
 
 _TESTS = {
     "finite": lambda x: True,
@@ -102,7 +102,7 @@ class GaussianSteps:
         return f"GaussianSteps(sigma_theta={self.sigma_theta!r})"
 
 
-@njit(cache=True)
+@cached_jit()
 def _ar1_in_place(y, phi):  # pragma: no cover - compiled; tested through OrnsteinUhlenbeck
     """y[q] += phi y[q - 1] for q = 1 ... len(y) - 1, in order: the AR(1) recursion, in place."""
     for q in range(1, y.size):

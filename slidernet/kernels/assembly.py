@@ -8,10 +8,11 @@ be written in place, since every row's length is known from the degrees.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from slidernet.kernels.state import cached_jit
 
 
-@njit(cache=True)
+@cached_jit()
 def _assemble(N, i, j, k, unit, indptr):
     """Fill the block rows of K (diagonal block first, then springs in edge order), then sort each row.
 

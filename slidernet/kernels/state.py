@@ -7,9 +7,12 @@ point and resume later (buffer refills, checkpoints).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 
+import numba
 import numpy as np
+import platformdirs
 from numba import njit
 
 try:
@@ -31,10 +34,41 @@ def kernel_jit(**options) -> Callable:
     its arithmetic. ``_nrt=False`` compiles without it. It is a private
     numba flag, so a numba that refuses it gets the plain decorator.
     """
-    options = {"cache": True, **options}
     if _NUMBA_HAS_NRT_FLAG:
         options["_nrt"] = False
-    return njit(**options)
+    return cached_jit(**options)
+
+
+def cache_dir() -> str:
+    """Where numba keeps slidernet's compiled kernels.
+
+    ``NUMBA_CACHE_DIR`` when the user set it, else ``numba`` in the per-user
+    cache directory (``platformdirs.user_cache_dir("slidernet")``, e.g.
+    ``~/.cache/slidernet/numba`` on Linux). Never inside the installed
+    package: cache files left in ``site-packages/slidernet/`` by a
+    ``pip install .`` outlive a ``pip uninstall`` and then shadow an editable
+    install as an empty namespace package.
+    """
+    return os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
+
+
+def cached_jit(**options) -> Callable:
+    """``numba.njit(cache=True, **options)`` with the cache in :func:`cache_dir`.
+
+    numba picks a function's cache folder when the function is decorated,
+    from ``numba.config.CACHE_DIR``; setting it only for the time of the
+    decoration keeps every other package's numba cache where it was.
+    """
+
+    def decorate(func: Callable) -> Callable:
+        saved = numba.config.CACHE_DIR
+        numba.config.CACHE_DIR = cache_dir()
+        try:
+            return njit(cache=True, **options)(func)
+        finally:
+            numba.config.CACHE_DIR = saved
+
+    return decorate
 
 # Return codes.
 DONE = 0
