@@ -15,12 +15,13 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from slidernet.errors import SlidernetError, UnknownPluginError
+from slidernet.errors import RunInterrupted, SlidernetError, UnknownPluginError
 
 if TYPE_CHECKING:
     from slidernet.registry import Registry
@@ -39,7 +40,7 @@ def _parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="run a configuration and write DIR/result.nc")
     r.add_argument("config", type=Path, help="TOML configuration (see MODEL.md section 5)")
     r.add_argument("--out", type=Path, required=True, help="output directory")
-    r.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _progress_flag(r)
     _execution_flags(r)
 
     sw = sub.add_parser(
@@ -51,12 +52,17 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--set", dest="sets", action="append", required=True, metavar="KEY=V1,V2,...",
                     help="a dotted configuration key and its values, e.g. driver.sigma_theta=1e-7,1e-6")
     sw.add_argument("--out", type=Path, required=True, help="output directory")
-    sw.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _progress_flag(sw)
     _execution_flags(sw)
 
     pp = sub.add_parser("paper", help="reproduce the four figures of Geminard & Bertin (2010)")
     pp.add_argument("--out", type=Path, required=True, help="output directory")
     pp.add_argument("--quick", action="store_true", help="small preset (under 2 minutes)")
+    _progress_flag(pp)
+    pp.add_argument("--resume", action="store_true",
+                    help="continue an interrupted reproduction in --out: finished runs are read back, the "
+                         "interrupted one resumes to the same bits")
+    pp.add_argument("--overwrite", action="store_true", help="replace a finished reproduction in --out")
 
     b = sub.add_parser("bench", help="measurements of slidernet itself")
     bsub = b.add_subparsers(dest="bench", required=True)
@@ -68,7 +74,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     se.add_argument("--out", type=Path, required=True, help="output directory")
     se.add_argument("--quick", action="store_true", help="small preset (under 3 minutes)")
-    se.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _progress_flag(se)
 
     sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
 
@@ -91,13 +97,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _progress_flag(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--no-progress", action="store_true",
+                   help="hide the progress bar (it is shown only when stderr is a terminal)")
+
+
+def _progress(args: argparse.Namespace) -> bool | None:
+    """False with --no-progress; else None: a bar only when stderr is a terminal (tqdm's rule)."""
+    return False if args.no_progress else None
+
+
 def _execution_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=int, help="local worker processes (default: execution.workers, "
                                                "else every core)")
     p.add_argument("--scheduler", help="a Dask scheduler address, e.g. tcp://host:8786 (default: "
                                        "execution.scheduler)")
+    p.add_argument("--scheduler-timeout", dest="scheduler_timeout", type=float,
+                   help="seconds to wait for the Dask scheduler (default: execution.scheduler_timeout, 10)")
     p.add_argument("--resume", action="store_true",
                    help="continue the interrupted run in --out (same configuration), to the same bits")
+    p.add_argument("--overwrite", action="store_true", help="replace a finished result in --out")
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -105,8 +124,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.runner import run
 
     cfg = load_config(args.config)  # validate before any work or any file
-    with run(cfg, progress=not args.no_progress, out=args.out, resume=args.resume, workers=args.workers,
-             scheduler=args.scheduler) as ds:
+    with run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
+             scheduler=args.scheduler, overwrite=args.overwrite, scheduler_timeout=args.scheduler_timeout) as ds:
         print(f"wrote {args.out / 'result.nc'} (seed {ds.attrs['seed']}, kernel {ds.attrs['kernel']})")
     return 0
 
@@ -114,8 +133,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from slidernet.sweep import parse_grid, sweep
 
-    ds = sweep(args.config, parse_grid(args.sets), progress=not args.no_progress, out=args.out,
-               resume=args.resume, workers=args.workers, scheduler=args.scheduler)
+    ds = sweep(args.config, parse_grid(args.sets), progress=_progress(args), out=args.out,
+               resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
+               scheduler_timeout=args.scheduler_timeout)
     swept = [name for name in ds.dims if "sweep_key" in ds[name].attrs]
     print(f"wrote {args.out / 'result.nc'} ({' x '.join(f'{ds.sizes[d]} {d}' for d in swept)} points)")
     return 0
@@ -124,7 +144,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _cmd_paper(args: argparse.Namespace) -> int:
     from slidernet.paper import reproduce
 
-    files = reproduce(args.out, quick=args.quick, progress=True)
+    files = reproduce(args.out, quick=args.quick, progress=_progress(args), resume=args.resume,
+                      overwrite=args.overwrite)
     for name, path in files.items():
         print(f"{name}: {path}")
     return 0
@@ -133,7 +154,7 @@ def _cmd_paper(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from slidernet.speed_error import speed_error
 
-    files = speed_error(args.out, quick=args.quick, progress=not args.no_progress)
+    files = speed_error(args.out, quick=args.quick, progress=_progress(args))
     for name, path in files.items():
         print(f"{name}: {path}")
     return 0
@@ -188,14 +209,29 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "plugins": _cmd_plugins,
                 "units": _cmd_units}
     try:
-        return commands[args.command](args)
+        status = commands[args.command](args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit
+        return status
     except SlidernetError as exc:
         print(f"slidernet: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt as exc:
-        print(f"slidernet: {exc}" if str(exc) else "slidernet: interrupted; no partial result was written.",
+    except RunInterrupted as exc:
+        print(f"slidernet: {exc}", file=sys.stderr)
+        return 128 + exc.signum
+    except KeyboardInterrupt:
+        print("slidernet: interrupted; files already written are complete, nothing else was saved.",
               file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # The reader went away (`slidernet units ... | head`): say so once, on stderr, and make
+        # the interpreter's own flush of stdout at exit write nowhere instead of raising again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print("slidernet: error: the output pipe was closed before everything was written.", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        where = f" {exc.filename!r}:" if exc.filename else ""
+        print(f"slidernet: error:{where} {exc.strerror or exc}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -263,7 +263,9 @@ class ExecutionConfig(_Strict):
     ``workers`` local processes run the realizations (None: every core this
     process may use); ``scheduler`` (``"tcp://host:port"``) sends them to a
     Dask distributed cluster instead. ``checkpoint_every`` (seconds) is how
-    often a run with an output directory saves its work. Realization r is
+    often a run with an output directory saves its work, and
+    ``scheduler_timeout`` (seconds) how long to wait for the scheduler to
+    answer before giving up with a message. Realization r is
     always driven by child r of the seed and the ensemble is reduced in
     realization order, so the same config gives the same bits on 1 worker,
     N workers or a cluster; this table is kept out of the identity of a run
@@ -273,6 +275,7 @@ class ExecutionConfig(_Strict):
     workers: Annotated[int, Field(ge=1)] | None = None
     scheduler: str | None = None
     checkpoint_every: Annotated[float, Field(gt=0)] = 60.0
+    scheduler_timeout: Annotated[float, Field(gt=0)] = 10.0
 
     @field_validator("scheduler")
     @classmethod

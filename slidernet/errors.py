@@ -35,8 +35,30 @@ class CheckpointError(SlidernetError, ValueError):
     """A checkpoint file is unreadable, or belongs to another run or scene."""
 
 
+class OutputError(SlidernetError, OSError):
+    """An output path cannot be used (a file where a folder is wanted, no permission, no such parent),
+    or it holds a finished result that would be replaced without ``overwrite``."""
+
+
+class SchedulerError(SlidernetError, ConnectionError):
+    """The Dask scheduler could not be reached within ``execution.scheduler_timeout``."""
+
+
 class RunInterrupted(KeyboardInterrupt):
-    """A run stopped by Ctrl-C after saving its work; the message says how to resume it."""
+    """A run stopped by Ctrl-C (SIGINT) or SIGTERM after saving its work; the message says how to resume.
+
+    Parameters
+    ----------
+    message : str
+        What was saved and how to resume.
+    signum : int
+        The signal that stopped the run (``signal.SIGINT`` or ``signal.SIGTERM``);
+        the command line exits with 128 + signum, as a shell does.
+    """
+
+    def __init__(self, message: str = "", signum: int = 2) -> None:
+        super().__init__(message)
+        self.signum = int(signum)
 
 
 def param_error(param: str, owner: str, requirement: str, got: object) -> ConfigError:

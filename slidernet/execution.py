@@ -30,14 +30,18 @@ import json
 import multiprocessing
 import os
 import signal
+import threading
 import time
+import uuid
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from slidernet.errors import SchedulerError
 
 Record = dict[str, Any]
 
@@ -72,63 +76,112 @@ def scene_of(config_json: str):
     return Scene.from_config(load_config(json.loads(config_json)))
 
 
-class _DeferredInterrupt:
-    """Hold Ctrl-C (SIGINT) until the realization is at a clean point between two steps.
+# The stop flag of this process: set by the runner's signal handler in this
+# process, or replaced by a pool worker's initializer with the flag the parent
+# sets (a multiprocessing.Event). Read by the tasks between chunks of steps.
+_PROCESS_STOP: Any = threading.Event()
 
-    A KeyboardInterrupt raised inside :meth:`Realization.advance` would leave
-    the state between a kernel's return and Python's handling of it (a refill,
-    a flushed event chunk): saving that would not resume to the same bits.
-    Only the main thread of a process can hold signals; elsewhere (a Dask
-    worker thread) this does nothing.
+
+class StopSignal:
+    """Ctrl-C (SIGINT) and SIGTERM during a run, as a context manager.
+
+    The first signal only asks: every running realization stops at its next
+    clean point between two chunks of thermal steps (at most about half a
+    second of work, or one step if a step takes longer), saves its state,
+    and no queued realization starts. A second signal stops at once, raising
+    KeyboardInterrupt where the main thread is: every file is written
+    atomically, so the folder still holds the last saved state of each
+    realization. Outside the main thread (where Python cannot catch
+    signals) this does nothing.
+
+    Attributes
+    ----------
+    signum : int or None
+        The first signal received (``signal.SIGINT`` or ``signal.SIGTERM``).
     """
 
-    def __init__(self) -> None:
-        self.pending = False
-        self._previous = None
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-    def __enter__(self) -> _DeferredInterrupt:
-        try:
-            self._previous = signal.signal(signal.SIGINT, self._hold)
-        except ValueError:  # not the main thread
-            self._previous = None
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self._previous: dict[int, Any] = {}
+
+    @property
+    def requested(self) -> bool:
+        """True once a signal asked the run to stop."""
+        return self.signum is not None
+
+    def request(self, signum: int = signal.SIGINT) -> None:
+        """Ask the run to stop, as the first signal does (hooks and tests call it directly)."""
+        if self.signum is None:
+            self.signum = int(signum)
+            _PROCESS_STOP.set()
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        if self.signum is not None:
+            raise KeyboardInterrupt
+        self.request(signum)
+
+    def __enter__(self) -> StopSignal:
+        global _PROCESS_STOP
+        _PROCESS_STOP = threading.Event()  # a fresh flag: an earlier run's stop is not this run's
+        if threading.current_thread() is threading.main_thread():
+            for sig in self.SIGNALS:
+                self._previous[sig] = signal.signal(sig, self._handle)
         return self
 
-    def _hold(self, signum, frame) -> None:
-        self.pending = True
-
-    def __exit__(self, *exc) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+    def __exit__(self, *exc: Any) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+        self._previous.clear()
 
 
-def _advance_with_checkpoints(real, partial: Path, every: float, meta: dict[str, Any]) -> None:
-    """Advance ``real`` to its end, saving it to ``partial`` every ``every`` seconds and on Ctrl-C."""
+def _stop_checker(stop: str | None) -> Callable[[], bool]:
+    """How a task learns that the run is stopping: its process's flag, or a Dask Event by name."""
+    if stop is None:
+        flag = _PROCESS_STOP
+        return flag.is_set
+    from distributed import Event
+
+    event = Event(stop)
+    return event.is_set
+
+
+def _advance_with_checkpoints(real, partial: Path | None, every: float, meta: dict[str, Any],
+                              stopped: Callable[[], bool]) -> bool:
+    """Advance ``real`` to its end, saving it to ``partial`` every ``every`` seconds.
+
+    Returns False if the run was stopped first (``stopped()`` became true):
+    the realization is then saved (when it has a ``partial`` path) at the
+    clean point where it stopped.
+    """
     from slidernet.checkpoint import save_realization
 
     steps = real.scene.steps
     chunk = 1
     # Chunks of at most a tenth of the interval, and half a second: a
-    # checkpoint or a Ctrl-C is never served much later than asked, and the
+    # checkpoint or a stop is never served much later than asked, and the
     # Python overhead per chunk stays negligible.
     target = min(0.1 * every, 0.5)
     last = time.monotonic()
-    with _DeferredInterrupt() as sigint:
-        while real.step < steps:
-            t0 = time.monotonic()
-            real.advance(min(real.step + chunk, steps))
-            took = time.monotonic() - t0
-            chunk = max(1, min(2 * chunk, int(chunk * target / took) if took > 0 else 2 * chunk))
-            if sigint.pending:
-                if real.step < steps:
-                    save_realization(real, partial, meta)
-                raise KeyboardInterrupt
-            if real.step < steps and time.monotonic() - last >= every:
+    while real.step < steps:
+        if stopped():
+            if partial is not None:
                 save_realization(real, partial, meta)
-                last = time.monotonic()
+            return False
+        t0 = time.monotonic()
+        real.advance(min(real.step + chunk, steps))
+        took = time.monotonic() - t0
+        chunk = max(1, min(2 * chunk, int(chunk * target / took) if took > 0 else 2 * chunk))
+        if partial is not None and real.step < steps and time.monotonic() - last >= every:
+            save_realization(real, partial, meta)
+            last = time.monotonic()
+    return True
 
 
 def run_realization(config_json: str, seed: int, r: int, partial: str | None = None,
-                    every: float = 60.0, meta: dict[str, Any] | None = None) -> Record:
+                    every: float = 60.0, meta: dict[str, Any] | None = None,
+                    stop: str | None = None) -> Record | None:
     """Run realization ``r`` of a configuration and return its records (the task of every backend).
 
     Parameters
@@ -146,27 +199,34 @@ def run_realization(config_json: str, seed: int, r: int, partial: str | None = N
         Seconds between two saves.
     meta : dict, optional
         What identifies the run, stored in and checked against ``partial``.
+    stop : str, optional
+        The name of a Dask Event that asks the run to stop; None: this
+        process's own stop flag (see :class:`StopSignal`).
 
     Returns
     -------
-    dict
-        :meth:`slidernet.solver.Realization.result`.
+    dict or None
+        :meth:`slidernet.solver.Realization.result`; None if the run was
+        asked to stop before the realization ended (its state is then saved
+        in ``partial``, if given) or before it started.
     """
     from slidernet.solver import Realization
 
+    stopped = _stop_checker(stop)
+    if stopped():  # a queued realization does not start once the run is stopping
+        return None
     scene = scene_of(config_json)
     ss = realization_seed(seed, r)
-    if partial is None:
-        return Realization(scene, ss).advance().result()
-    path = Path(partial)
+    path = None if partial is None else Path(partial)
     meta = {**(meta or {}), "realization": r}
-    if path.exists():
+    if path is not None and path.exists():
         from slidernet.checkpoint import load_realization
 
         real = load_realization(scene, ss, path, expect_meta=meta)
     else:
         real = Realization(scene, ss)
-    _advance_with_checkpoints(real, path, every, meta)
+    if not _advance_with_checkpoints(real, path, every, meta, stopped):
+        return None
     return real.result()
 
 
@@ -188,9 +248,13 @@ def _reraise(result: tuple[Record, list[tuple[type[Warning], str]]]) -> Record:
     return record
 
 
-def _in_process(indices: Sequence[int], args: Task) -> Iterator[tuple[int, Record]]:
+def _in_process(indices: Sequence[int], args: Task, stop: StopSignal) -> Iterator[tuple[int, Record]]:
     for r in indices:
-        yield r, run_realization(*args(r))
+        if stop.requested:
+            return
+        record = run_realization(*args(r))
+        if record is not None:
+            yield r, record
 
 
 def _window(workers: int) -> int:
@@ -198,62 +262,140 @@ def _window(workers: int) -> int:
     return 4 * workers
 
 
-def _local_pool(indices: Sequence[int], args: Task, workers: int) -> Iterator[tuple[int, Record]]:
+# How often the parent looks at the signal flag while it waits for results, in s.
+_POLL = 0.1
+
+
+def _init_worker(flag: Any) -> None:
+    """Initializer of a pool worker: the parent's flag is its stop flag; signals are the parent's."""
+    global _PROCESS_STOP
+    _PROCESS_STOP = flag
+    # Ctrl-C reaches every process of the terminal's group, and a batch
+    # scheduler may send SIGTERM to every process of a job. The parent alone
+    # decides, through the flag, so that each running realization stops at a
+    # clean point and saves; a worker killed by the signal would lose its work.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+
+def _terminate(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's workers now (a second Ctrl-C): their last saves are complete files."""
+    kill = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if kill is not None:
+        kill()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
+
+
+def _local_pool(indices: Sequence[int], args: Task, workers: int,
+                stop: StopSignal) -> Iterator[tuple[int, Record]]:
     method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    ctx = multiprocessing.get_context(method)
+    flag = ctx.Event()
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker, initargs=(flag,))
     todo = iter(indices)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method)) as pool:
-        running: dict[Any, int] = {}
+    running: dict[Future, int] = {}
+
+    def submit_next() -> bool:
+        r = next(todo, None)
+        if r is None:
+            return False
+        running[pool.submit(_task, *args(r))] = r
+        return True
+
+    forced = False
+    try:
+        while len(running) < _window(workers) and submit_next():
+            pass
+        while running:
+            if stop.requested and not flag.is_set():
+                flag.set()
+                for fut in running:
+                    fut.cancel()  # queued tasks; those already handed to a worker return at once
+            done, _ = wait(running, timeout=_POLL, return_when=FIRST_COMPLETED)
+            for fut in done:
+                r = running.pop(fut)
+                if fut.cancelled():
+                    continue
+                record = _reraise(fut.result())
+                if record is not None:
+                    yield r, record
+                if not stop.requested:
+                    submit_next()
+    except KeyboardInterrupt:
+        forced = True
+        raise
+    finally:
+        # On any way out (an error, the caller stopping early, a second
+        # Ctrl-C) running realizations are told to stop and save.
+        flag.set()
         try:
-            for r in todo:
-                running[pool.submit(_task, *args(r))] = r
-                if len(running) >= _window(workers):
-                    break
+            if forced:
+                _terminate(pool)
+            pool.shutdown(wait=True, cancel_futures=True)
+        except KeyboardInterrupt:  # a second Ctrl-C while the workers save
+            _terminate(pool)
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
+          timeout: float) -> Iterator[tuple[int, Record]]:
+    from distributed import Client, Event
+    from distributed import wait as dask_wait
+
+    try:
+        client = Client(scheduler, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise SchedulerError(
+            f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
+            f"(execution.scheduler_timeout): {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}."
+        ) from None
+    with client:
+        workers = max(1, sum(client.nthreads().values()))
+        name = f"slidernet-stop-{uuid.uuid4().hex}"
+        event = Event(name, client=client)
+        todo = iter(indices)
+        running: dict[Any, int] = {}
+
+        def submit_next() -> bool:
+            r = next(todo, None)
+            if r is None:
+                return False
+            running[client.submit(_task, *args(r), name, pure=False)] = r
+            return True
+
+        try:
+            while len(running) < _window(workers) and submit_next():
+                pass
             while running:
-                done, _ = wait(running, return_when=FIRST_COMPLETED)
+                if stop.requested and not event.is_set():
+                    # Queued tasks see the event as they start and return at once.
+                    event.set()
+                try:
+                    done, _ = dask_wait(list(running), timeout=_POLL, return_when="FIRST_COMPLETED")
+                except TimeoutError:
+                    continue
                 for fut in done:
                     r = running.pop(fut)
-                    yield r, _reraise(fut.result())
-                    nxt = next(todo, None)
-                    if nxt is not None:
-                        running[pool.submit(_task, *args(nxt))] = nxt
-        except BaseException:
-            for fut in running:
-                fut.cancel()
-            raise
+                    record = _reraise(fut.result())
+                    fut.release()
+                    if record is not None:
+                        yield r, record
+                    if not stop.requested:
+                        submit_next()
+        finally:
+            if running:
+                event.set()
+                try:
+                    dask_wait(list(running), timeout=60)
+                except (TimeoutError, KeyboardInterrupt):
+                    pass
 
 
-def _dask(indices: Sequence[int], args: Task, scheduler: str) -> Iterator[tuple[int, Record]]:
-    from distributed import Client, as_completed
-
-    with Client(scheduler) as client:
-        workers = max(1, sum(client.nthreads().values()))
-        todo = iter(indices)
-        keys: dict[str, int] = {}
-        queue = as_completed()
-        try:
-            for r in todo:
-                fut = client.submit(_task, *args(r), pure=False)
-                keys[fut.key] = r
-                queue.add(fut)
-                if len(keys) >= _window(workers):
-                    break
-            for fut in queue:
-                r = keys.pop(fut.key)
-                result = _reraise(fut.result())
-                fut.release()
-                yield r, result
-                nxt = next(todo, None)
-                if nxt is not None:
-                    new = client.submit(_task, *args(nxt), pure=False)
-                    keys[new.key] = nxt
-                    queue.add(new)
-        except BaseException:
-            queue.clear()
-            raise
-
-
-def execute(indices: Sequence[int], args: Task, workers: int = 1,
-            scheduler: str | None = None) -> Iterator[tuple[int, Record]]:
+def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str | None = None,
+            stop: StopSignal | None = None, scheduler_timeout: float = 10.0) -> Iterator[tuple[int, Record]]:
     """Run the realizations ``indices``; yield ``(r, records)`` as they finish (in any order).
 
     Parameters
@@ -266,9 +408,17 @@ def execute(indices: Sequence[int], args: Task, workers: int = 1,
         Local worker processes (1: in this process).
     scheduler : str, optional
         Address of a Dask scheduler; when given, ``workers`` is ignored.
+    stop : StopSignal, optional
+        Once it is requested no realization starts, and the running ones
+        stop at a clean point, save, and are not yielded; the iteration then
+        ends. None: never requested.
+    scheduler_timeout : float
+        Seconds to wait for the Dask scheduler before raising
+        :class:`~slidernet.errors.SchedulerError`.
     """
+    stop = StopSignal() if stop is None else stop
     if scheduler is not None:
-        return _dask(indices, args, scheduler)
+        return _dask(indices, args, scheduler, stop, scheduler_timeout)
     if workers <= 1 or len(indices) <= 1:
-        return _in_process(indices, args)
-    return _local_pool(indices, args, min(workers, len(indices)))
+        return _in_process(indices, args, stop)
+    return _local_pool(indices, args, min(workers, len(indices)), stop)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -15,7 +16,7 @@ from tqdm.auto import tqdm
 import slidernet
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
 from slidernet.errors import RunInterrupted, param_error
-from slidernet.execution import available_cores, execute, scene_of
+from slidernet.execution import StopSignal, available_cores, execute, scene_of
 from slidernet.io import write_result_stream
 from slidernet.observables import CHUNK, assemble
 from slidernet.store import RunStore
@@ -61,6 +62,8 @@ def run(
     resume: bool = False,
     workers: int | None = None,
     scheduler: str | None = None,
+    overwrite: bool = False,
+    scheduler_timeout: float | None = None,
 ) -> xr.Dataset:
     """Simulate an ensemble of realizations and return the result dataset.
 
@@ -84,6 +87,12 @@ def run(
         Continue the interrupted run in ``out`` (same configuration; the
         execution table may differ). The result is the bits of an
         uninterrupted run.
+    overwrite : bool
+        Replace a finished ``out/result.nc``. Without it such a folder is
+        refused before any work.
+    scheduler_timeout : float, optional
+        Seconds to wait for the Dask scheduler; overrides
+        ``execution.scheduler_timeout`` (default 10).
     workers : int, optional
         Local worker processes; overrides ``execution.workers`` (default:
         every core).
@@ -102,8 +111,16 @@ def run(
     Raises
     ------
     RunInterrupted
-        On Ctrl-C, after the finished realizations (and, inside a realization,
-        its state) are saved under ``out``; its message says how to resume.
+        On Ctrl-C (SIGINT) or SIGTERM: the running realizations stop at
+        their next clean point, and with ``out`` the finished ones and the
+        state of the running ones are saved; its message says how to resume
+        and its ``signum`` which signal stopped the run.
+    OutputError
+        If ``out`` cannot be used as a folder, or holds a finished result
+        and ``overwrite`` is not set.
+    SchedulerError
+        If the Dask scheduler does not answer within
+        ``execution.scheduler_timeout`` seconds.
 
     Examples
     --------
@@ -124,18 +141,53 @@ def run(
         raise param_error("workers", "run", "an integer >= 1", workers)
     if scheduler is not None and not is_scheduler_address(scheduler):
         raise param_error("scheduler", "run", SCHEDULER_REQUIREMENT, scheduler)
+    if scheduler_timeout is not None and (isinstance(scheduler_timeout, bool)
+                                          or not isinstance(scheduler_timeout, (int, float))
+                                          or not scheduler_timeout > 0):
+        raise param_error("scheduler_timeout", "run", "a number of seconds > 0", scheduler_timeout)
     workers = workers or ex.workers or available_cores()
     scheduler = scheduler or ex.scheduler
+    timeout = float(scheduler_timeout or ex.scheduler_timeout)
     R = cfg.realizations
+    config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
+    scene = scene_of(config_json)  # validates the scene before any file is touched; forked workers inherit it
     store = None
     if out is not None:
-        store = RunStore(out, identity(requested, cfg), resume)
+        store = RunStore(out, identity(requested, cfg), resume, overwrite=overwrite)
         seed = store.open()
         if seed != cfg.seed:  # a resumed run whose config left the seed to fresh entropy
             cfg = _with_seed(cfg, seed)
-    config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
-    scene = scene_of(config_json)  # validates the scene; forked workers inherit it
-    done = store.done() if store is not None else {}
+            config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
+    try:
+        done = store.done() if store is not None else {}
+        records = _execute(cfg, config_json, requested, store, done, progress, on_realization, workers,
+                           scheduler, timeout)
+    except RunInterrupted:
+        raise
+    except BaseException:
+        if store is not None:
+            store.abandon()  # a run that failed before saving anything leaves the folder as it found it
+        raise
+    attrs = _attrs(cfg, scene.kernel, workers, scheduler)
+    if store is None:
+        return assemble((records.pop(r) for r in range(R)), scene.rec_times, list(cfg.observables), attrs)
+    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.rec_times, R,
+                               list(cfg.observables), attrs)
+    store.remove()
+    return xr.open_dataset(path, engine="netcdf4")
+
+
+def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore | None,
+             done: Mapping[int, Any], progress: bool | None, on_realization: Callable[[int], None] | None,
+             workers: int, scheduler: str | None, timeout: float) -> dict[int, dict]:
+    """Run the realizations not ``done``; records kept in memory, or in ``store`` (flushed as they come).
+
+    Ctrl-C and SIGTERM stop the run at a clean point of every running
+    realization (see :class:`slidernet.execution.StopSignal`): the work is
+    saved in ``store`` and :class:`RunInterrupted` says how to resume.
+    """
+    ex = cfg.execution
+    R = cfg.realizations
     pending = [r for r in range(R) if r not in done]
     meta = {"config": json.dumps(identity(requested, cfg), sort_keys=True)}
 
@@ -143,42 +195,52 @@ def run(
         partial = None if store is None else str(store.partial(r))
         return config_json, cfg.seed, r, partial, ex.checkpoint_every, meta
 
-    attrs = _attrs(cfg, scene.kernel, workers, scheduler)
     bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
-    try:
-        for r, rec in execute(pending, args, workers, scheduler):
-            if store is None:
-                records[r] = rec
-            else:
-                store.add(r, rec)
-                if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
-                    store.flush()
-                    last_flush = time.monotonic()
-            bar.update()
-            if on_realization is not None:
-                on_realization(r)
-    except KeyboardInterrupt:
-        if store is None:
-            raise
+    with StopSignal() as stop:
+        results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout)
+        try:
+            for r, rec in results:
+                if store is None:
+                    records[r] = rec
+                else:
+                    store.add(r, rec)
+                    if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
+                        store.flush()
+                        last_flush = time.monotonic()
+                bar.update()
+                if on_realization is not None:
+                    on_realization(r)
+        except KeyboardInterrupt:
+            stop.request(signal.SIGINT)
+        finally:
+            results.close()  # running realizations stop and save before the pool goes
+            bar.close()
+        if stop.requested:
+            raise _interrupted(store, R, stop.signum)
+    if store is not None:
         store.flush()
-        saved = len(store.done())
-        raise RunInterrupted(
-            f"interrupted: {saved} of {R} realizations are saved in {str(store.dir)!r} (and the state of "
-            f"those in progress); continue with `slidernet run CONFIG --out {str(out)!r} --resume` or "
-            f"slidernet.run(config, out=..., resume=True)."
-        ) from None
-    finally:
-        bar.close()
+    return records
+
+
+def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:
+    """Save what is finished; the exception that says what is saved and how to resume."""
+    name = signal.Signals(signum).name
     if store is None:
-        return assemble((records.pop(r) for r in range(R)), scene.rec_times, list(cfg.observables), attrs)
+        return RunInterrupted(f"interrupted by {name}; nothing was saved (run with an output directory "
+                              "to keep the work of an interrupted run).", signum)
     store.flush()
-    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.rec_times, R,
-                               list(cfg.observables), attrs)
-    store.remove()
-    return xr.open_dataset(path, engine="netcdf4")
+    saved = len(store.done())
+    running = store.partials()
+    return RunInterrupted(
+        f"interrupted by {name}: {saved} of {R} realizations are finished"
+        + (f" and {running} saved in progress" if running else "")
+        + f" in {str(store.dir)!r}; continue with --resume on the same command, "
+        f"e.g. `slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`.",
+        signum,
+    )
 
 
 def _with_seed(cfg: Config, seed: int) -> Config:

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from slidernet.errors import CheckpointError
+from slidernet.errors import CheckpointError, OutputError
 from slidernet.io import atomic_output
 
 Record = dict[str, Any]
@@ -61,16 +61,39 @@ class RunStore:
         interrupted run is refused rather than overwritten.
     """
 
-    def __init__(self, out_dir: str | Path, identity: dict[str, Any], resume: bool) -> None:
+    def __init__(self, out_dir: str | Path, identity: dict[str, Any], resume: bool,
+                 overwrite: bool = False) -> None:
         self.dir = Path(out_dir) / "checkpoint"
         self.identity = dict(identity)
         self.resume = resume
+        self.overwrite = overwrite
         self._buffer: dict[int, Record] = {}
+        self._created: list[Path] = []  # folders this run made, outermost first (undone by abandon)
 
     # -- opening ---------------------------------------------------------
     def open(self) -> int:
-        """Create or check the folder; return the seed to use (the stored one on resume)."""
+        """Create or check the folder; return the seed to use (the stored one on resume).
+
+        Raises
+        ------
+        OutputError
+            If the output directory is a file or cannot be created, or it
+            holds a finished ``result.nc`` and neither ``overwrite`` nor a
+            run to resume is there.
+        CheckpointError
+            If it holds an interrupted run and ``resume`` is not set, or
+            another run's checkpoint, or nothing to resume.
+        """
+        out = self.dir.parent
+        if out.exists() and not out.is_dir():
+            raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
         run_json = self.dir / "run.json"
+        result = out / "result.nc"
+        if result.exists() and not run_json.exists() and not self.overwrite:
+            raise OutputError(
+                f"{str(out)!r} holds a finished result ({str(result)!r}); it is not replaced silently. "
+                "Use --overwrite (overwrite=True) to replace it, or another output directory."
+            )
         if run_json.exists():
             try:
                 stored = json.loads(run_json.read_text())
@@ -80,8 +103,7 @@ class RunStore:
             if not self.resume:
                 raise CheckpointError(
                     f"{str(self.dir.parent)!r} holds an interrupted run ({done} of {stored.get('realizations')} "
-                    f"realizations done). Continue it with --resume (resume=True), or remove "
-                    f"{str(self.dir)!r} to start again."
+                    f"realizations done). Continue it with --resume, or remove {str(self.dir)!r} to start again."
                 )
             diff = _flat_diff(stored["config"], self.identity["config"])
             if stored.get("realizations") != self.identity["realizations"]:
@@ -100,11 +122,53 @@ class RunStore:
             self.identity["seed"] = stored["seed"]
             return int(stored["seed"])
         if self.resume:
-            raise CheckpointError(f"Nothing to resume in {str(self.dir.parent)!r}: it has no checkpoint folder.")
-        self.dir.mkdir(parents=True, exist_ok=True)
-        with atomic_output(run_json) as tmp:
-            tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
+            finished = " (its run is finished: result.nc is there)" if result.exists() else ""
+            raise CheckpointError(
+                f"Nothing to resume in {str(self.dir.parent)!r}: it has no checkpoint folder{finished}.")
+        self._make_dirs()
+        try:
+            with atomic_output(run_json) as tmp:
+                tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
+        except OSError as exc:
+            self.abandon()
+            raise OutputError(f"Cannot write in the output directory {str(out)!r}: {_reason(exc)}.") from None
         return int(self.identity["seed"])
+
+    def _make_dirs(self) -> None:
+        """Create the checkpoint folder and its missing parents, remembering which were made here."""
+        missing = [p for p in (self.dir, *self.dir.parents) if not p.exists()][::-1]
+        for path in missing:
+            try:
+                path.mkdir()
+            except FileExistsError:
+                if not path.is_dir():
+                    self.abandon()
+                    raise OutputError(f"The output path {str(path)!r} is a file; name a folder.") from None
+            except OSError as exc:
+                self.abandon()
+                raise OutputError(
+                    f"Cannot create the output directory {str(self.dir.parent)!r}: {_reason(exc)}.") from None
+            else:
+                self._created.append(path)
+
+    def abandon(self) -> None:
+        """Undo :meth:`open` after a failure, if nothing worth keeping was saved.
+
+        A run that failed before any realization finished or saved its state
+        leaves the output directory as it found it: the folders it created
+        are removed. Saved work (a block or a partial realization) is kept,
+        so that a fixed run can resume it.
+        """
+        if self._buffer or (self.dir.exists() and any(
+                _BLOCK.fullmatch(p.name) or p.name.startswith("partial-") for p in self.dir.iterdir())):
+            return
+        for path in reversed(self._created):
+            shutil.rmtree(path, ignore_errors=True)
+        self._created.clear()
+
+    def partials(self) -> int:
+        """The number of realizations saved in progress."""
+        return sum(1 for _ in self.dir.glob("partial-*.npz")) if self.dir.exists() else 0
 
     # -- finished realizations -------------------------------------------
     def _blocks(self) -> list[Path]:
@@ -177,6 +241,11 @@ class RunStore:
     def remove(self) -> None:
         """Delete the folder (the run's result is safely written)."""
         shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def _reason(exc: OSError) -> str:
+    """The OS's words for an error, without the traceback's chain."""
+    return exc.strerror or str(exc)
 
 
 # -- records <-> flat arrays ---------------------------------------------------
