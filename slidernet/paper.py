@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
+import signal
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -44,7 +46,9 @@ from tqdm.auto import tqdm
 import slidernet
 from slidernet import theory
 from slidernet.config import load_config
+from slidernet.errors import CheckpointError, OutputError, RunInterrupted
 from slidernet.io import write_netcdf
+from slidernet.runner import run_in
 from slidernet.sweep import sweep as run_sweep
 
 __all__ = ["FULL", "QUICK", "Preset", "reproduce"]
@@ -144,18 +148,27 @@ class _Job:
 
 
 class _Runner:
-    """Runs jobs under one progress bar whose total (estimated work) is known upfront."""
+    """Runs jobs under one progress bar whose total (estimated work) is known upfront.
 
-    def __init__(self, jobs: list[_Job], progress: bool) -> None:
-        self.bar = tqdm(total=sum(j.cost for j in jobs), disable=not progress, desc="paper figures",
+    Each job runs in its own folder ``runs/<label>`` of the output directory,
+    so that an interrupted reproduction resumes: finished runs are read back,
+    the interrupted one continues to the same bits.
+    """
+
+    def __init__(self, jobs: list[_Job], progress: bool | None, runs: Path, resume: bool) -> None:
+        self.bar = tqdm(total=sum(j.cost for j in jobs), desc="paper figures",
+                        disable=None if progress is None else not progress,
                         bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
+        self.runs = runs
+        self.resume = resume
 
     def run(self, job: _Job) -> xr.Dataset:
         step = _cost_per_realization(job.config)
         self.bar.set_postfix_str(job.label)
-        return slidernet.run(job.config, progress=False, on_realization=lambda _: self.bar.update(step))
+        return run_in(job.config, self.runs / job.label, resume=self.resume,
+                      on_realization=lambda _: self.bar.update(step))
 
-    def sweep(self, jobs: list[_Job], key: str) -> xr.Dataset:
+    def sweep(self, jobs: list[_Job], key: str, label: str) -> xr.Dataset:
         """One :func:`slidernet.sweep.sweep` over ``key``: point i is ``jobs[i]`` (same config but ``key``)."""
         values = [_get(j.config, key) for j in jobs]
         steps = [_cost_per_realization(j.config) for j in jobs]
@@ -164,7 +177,9 @@ class _Runner:
             self.bar.set_postfix_str(jobs[i].label)
             self.bar.update(steps[i])
 
-        return run_sweep(jobs[0].config, {key: values}, progress=False, on_realization=done)
+        folder = self.runs / label
+        return run_sweep(jobs[0].config, {key: values}, progress=False, on_realization=done, out=folder,
+                         resume=self.resume and (folder / "sweep.json").exists())
 
     def close(self) -> None:
         self.bar.close()
@@ -501,8 +516,8 @@ def _plot_fig4(ds: xr.Dataset, sigma_theta: float, path: Path) -> None:
 # driver
 
 
-def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *,
-              _preset: Preset | None = None) -> dict[str, Path]:
+def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = True, *,
+              resume: bool = False, overwrite: bool = False, _preset: Preset | None = None) -> dict[str, Path]:
     """Reproduce the paper's four result figures, with their data, in ``out_dir``.
 
     Parameters
@@ -512,8 +527,14 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
     quick : bool
         Use the :data:`QUICK` preset (short runs, about a minute) instead of
         :data:`FULL` (about ten minutes on two cores).
-    progress : bool
-        Show one progress bar over all the runs (estimated work, known upfront).
+    progress : bool or None
+        Show one progress bar over all the runs (estimated work, known
+        upfront); None: only on a terminal.
+    resume : bool
+        Continue the interrupted reproduction in ``out_dir``: finished runs
+        are read back from ``out_dir/runs``, the interrupted one resumes.
+    overwrite : bool
+        Replace a reproduction (finished or interrupted) in ``out_dir``.
     _preset : Preset, optional
         Internal: replaces the preset chosen by ``quick`` (tests use a tiny one).
 
@@ -528,7 +549,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
     start = time.perf_counter()
     p = _preset if _preset is not None else (QUICK if quick else FULL)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    runs = _prepare(out, resume, overwrite)
 
     obs12 = ("n", "mu_max", "x_G")
     jobs12 = [_Job(f"sigma_theta={s:g}", _config(s, p.fig12_steps, p.fig12_realizations, p.seed + i,
@@ -549,7 +570,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
                           points_per_decade=p.fig4_points_per_decade))
               for k, (md, rr, sm) in enumerate(cases)]
 
-    runner = _Runner([*jobs12, job3a, *jobs3b, *jobs4], progress)
+    runner = _Runner([*jobs12, job3a, *jobs3b, *jobs4], progress, runs, resume)
     files: dict[str, Path] = {}
     wall: dict[str, dict[str, float]] = {}
     try:
@@ -576,7 +597,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
 
         t0 = time.perf_counter()
         run3a = runner.run(job3a)
-        sweep3b = runner.sweep(jobs3b, "driver.sigma_theta")
+        sweep3b = runner.sweep(jobs3b, "driver.sigma_theta", "fig3b_sweep")
         ds3 = _fig3_data(run3a, sweep3b, [job3a.label] + [j.label for j in jobs3b])
         t_sim3 = time.perf_counter() - t0
         t0 = time.perf_counter()
@@ -594,6 +615,14 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
         _plot_fig4(ds4, p.fig4_sigma_theta, out / "fig4_mueff.png")
         files["fig4_mueff.png"] = out / "fig4_mueff.png"
         wall["fig4_mueff"] = {"simulation_s": t_sim4, "output_s": time.perf_counter() - t0}
+    except RunInterrupted as exc:
+        flags = " --quick" if quick else ""
+        raise RunInterrupted(
+            f"interrupted by {signal.Signals(exc.signum).name}: the runs done and the saved work of the "
+            f"running one are in {str(runs)!r}; continue with "
+            f"`slidernet paper --out {str(out)!r}{flags} --resume`.",
+            exc.signum,
+        ) from None
     finally:
         runner.close()
 
@@ -618,7 +647,31 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool = True, *
     tmp.write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
     tmp.replace(summary_path)
     files["summary.json"] = summary_path
+    shutil.rmtree(runs, ignore_errors=True)  # the figures' files hold the data; resume is over
     return files
+
+
+def _prepare(out: Path, resume: bool, overwrite: bool) -> Path:
+    """Check and make the output folder; return the folder of the runs (``out/runs``)."""
+    runs = out / "runs"
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
+    finished = (out / "summary.json").exists() and not runs.exists()
+    if overwrite and not resume:
+        shutil.rmtree(runs, ignore_errors=True)
+        (out / "summary.json").unlink(missing_ok=True)
+    elif resume and finished:
+        raise CheckpointError(f"Nothing to resume in {str(out)!r}: its reproduction is finished "
+                              "(summary.json is there). Use --overwrite to make it again.")
+    elif not resume and (finished or runs.exists()):
+        state = "a finished reproduction" if finished else "an interrupted reproduction"
+        raise OutputError(f"{str(out)!r} holds {state}; it is not replaced silently. Continue an "
+                          "interrupted one with --resume, replace it with --overwrite, or use another folder.")
+    try:
+        runs.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"Cannot create the output directory {str(out)!r}: {exc.strerror or exc}.") from None
+    return runs
 
 
 def _json_default(obj: Any) -> Any:
@@ -634,7 +687,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="short runs (about a minute)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     args = parser.parse_args(argv)
-    files = reproduce(args.out_dir, quick=args.quick, progress=not args.no_progress)
+    files = reproduce(args.out_dir, quick=args.quick, progress=False if args.no_progress else None)
     for name in sorted(files):
         print(files[name])
     return 0

@@ -15,9 +15,9 @@ from tqdm.auto import tqdm
 
 import slidernet
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
-from slidernet.errors import RunInterrupted, param_error
+from slidernet.errors import CheckpointError, RunInterrupted, param_error
 from slidernet.execution import StopSignal, available_cores, execute, scene_of
-from slidernet.io import write_result_stream
+from slidernet.io import read_result, write_result_stream
 from slidernet.observables import CHUNK, assemble
 from slidernet.store import RunStore
 
@@ -241,6 +241,55 @@ def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:
         f"e.g. `slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`.",
         signum,
     )
+
+
+def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, resume: bool = False,
+           overwrite: bool = False, on_realization: Callable[[int], None] | None = None,
+           **execution: Any) -> xr.Dataset:
+    """One run kept in its own folder, as a step of a larger job (a sweep point, a paper figure).
+
+    With ``resume``, a finished run (``out/result.nc`` and no checkpoint) is
+    read back, after checking that it holds this configuration; an
+    interrupted one is resumed; a run not yet started starts. Without it the
+    run starts, as :func:`run` does.
+
+    Parameters
+    ----------
+    config : Config, dict or path
+        The run's configuration (its seed set).
+    out : path
+        The run's folder.
+    resume, overwrite : bool
+        As in :func:`run`.
+    on_realization : callable, optional
+        Called with each realization's index once it is done (or found done).
+    **execution
+        ``workers``, ``scheduler``, ``scheduler_timeout`` of :func:`run`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The result, loaded in memory (its file is closed).
+    """
+    cfg = load_config(config)
+    out = Path(out)
+    # The store keeps a run's checkpoint folder until its result.nc is written.
+    unfinished = (out / "checkpoint").exists()
+    if resume and not unfinished and (out / "result.nc").exists():
+        ds = read_result(out / "result.nc")
+        expected = json.loads(json.dumps(cfg.model_dump(mode="json", exclude={"execution"})))
+        if json.loads(ds.attrs["config"]) != expected:
+            raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} holds a run of another "
+                                  "configuration than this one.")
+        for r in range(cfg.realizations):
+            if on_realization is not None:
+                on_realization(r)
+        return ds
+    ds = run(cfg, progress=False, on_realization=on_realization, out=out, resume=resume and unfinished,
+             overwrite=overwrite, **execution)
+    ds.load()
+    ds.close()
+    return ds
 
 
 def _with_seed(cfg: Config, seed: int) -> Config:

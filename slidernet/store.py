@@ -94,6 +94,8 @@ class RunStore:
                 f"{str(out)!r} holds a finished result ({str(result)!r}); it is not replaced silently. "
                 "Use --overwrite (overwrite=True) to replace it, or another output directory."
             )
+        if run_json.exists() and self.overwrite and not self.resume:
+            shutil.rmtree(self.dir)  # asked for: the interrupted run there is replaced
         if run_json.exists():
             try:
                 stored = json.loads(run_json.read_text())
@@ -103,7 +105,7 @@ class RunStore:
             if not self.resume:
                 raise CheckpointError(
                     f"{str(self.dir.parent)!r} holds an interrupted run ({done} of {stored.get('realizations')} "
-                    f"realizations done). Continue it with --resume, or remove {str(self.dir)!r} to start again."
+                    f"realizations done). Continue it with --resume, or start again with --overwrite."
                 )
             diff = _flat_diff(stored["config"], self.identity["config"])
             if stored.get("realizations") != self.identity["realizations"]:

@@ -59,6 +59,8 @@ import copy
 import itertools
 import json
 import re
+import shutil
+import signal
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from numbers import Number
@@ -72,8 +74,8 @@ from tqdm.auto import tqdm
 import slidernet
 from slidernet import runner
 from slidernet.config import Config, load_config, read_toml
-from slidernet.errors import CheckpointError, ConfigError, RunInterrupted
-from slidernet.io import atomic_output, read_result, write_netcdf
+from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
+from slidernet.io import atomic_output, write_netcdf
 from slidernet.solver import Scene, record_times
 
 if sys.version_info >= (3, 11):
@@ -242,6 +244,8 @@ def sweep(
     resume: bool = False,
     workers: int | None = None,
     scheduler: str | None = None,
+    overwrite: bool = False,
+    scheduler_timeout: float | None = None,
 ) -> xr.Dataset:
     """Run ``config`` at every point of the product ``grid`` and return one dataset.
 
@@ -269,13 +273,15 @@ def sweep(
     out : str or Path, optional
         Output folder: ``out/sweep.json``, point i in ``out/points/<i>/``,
         the result written atomically to ``out/result.nc``. A folder that
-        holds a sweep is refused unless ``resume``.
+        holds a sweep is refused unless ``resume`` or ``overwrite``.
     resume : bool
         Continue the killed sweep in ``out``, point by point (same
         configuration and grid; the seed stored there).
-    workers, scheduler
+    workers, scheduler, scheduler_timeout
         Passed to :func:`slidernet.run` for every point (where the
         realizations run; never changes a result).
+    overwrite : bool
+        Replace the sweep in ``out`` (finished or not) with this one.
 
     Returns
     -------
@@ -296,8 +302,8 @@ def sweep(
     CheckpointError
         If ``out`` holds another sweep, or (on resume) none.
     RunInterrupted
-        On Ctrl-C with ``out``, once the work done is saved; its message
-        says how to resume.
+        On Ctrl-C or SIGTERM, once the work done is saved (with ``out``);
+        its message says how to resume.
 
     Examples
     --------
@@ -320,6 +326,8 @@ def sweep(
     identity = _identity(base, grid)
     seed = base.get("seed")
     if folder is not None:
+        if overwrite and not resume:
+            _clear_folder(folder)
         stored_seed = _check_folder(folder, identity, resume)
         seed = stored_seed if stored_seed is not None else seed
     if seed is None:
@@ -335,7 +343,8 @@ def sweep(
     if folder is not None and not resume:
         with atomic_output(folder / _SWEEP_JSON) as tmp:
             tmp.write_text(json.dumps({**identity, "seed": seed}, indent=1))
-    execution = {k: v for k, v in (("workers", workers), ("scheduler", scheduler)) if v is not None}
+    execution = {k: v for k, v in (("workers", workers), ("scheduler", scheduler),
+                                   ("scheduler_timeout", scheduler_timeout)) if v is not None}
     R = cfgs[0].realizations
     bar = tqdm(total=len(cfgs) * R, desc="sweep", disable=None if progress is None else not progress)
     results = []
@@ -345,13 +354,18 @@ def sweep(
             done = _counter(bar, on_realization, i)
             where = None if folder is None else folder / "points" / str(i)
             results.append(_run_point(cfg, where, resume, done, execution))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
         if folder is None:
-            raise
+            raise RunInterrupted(f"interrupted by {signal.Signals(signum).name}; nothing was saved (sweep "
+                                 "with an output directory to keep the work of an interrupted sweep).",
+                                 signum) from None
         raise RunInterrupted(
-            f"interrupted: {len(results)} of {len(cfgs)} sweep points are done in {str(folder / 'points')!r} "
-            f"(and the saved work of point {len(results)}); continue with `slidernet sweep CONFIG --set ... "
-            f"--out {str(folder)!r} --resume` or sweep(config, grid, out=..., resume=True)."
+            f"interrupted by {signal.Signals(signum).name}: {len(results)} of {len(cfgs)} sweep points are done "
+            f"in {str(folder / 'points')!r}, and the work of point {len(results)} is saved; continue with "
+            f"--resume on the same command, e.g. "
+            f"`slidernet sweep CONFIG --set ... --out {str(folder)!r} --resume`.",
+            signum,
         ) from None
     finally:
         bar.close()
@@ -382,13 +396,25 @@ def _identity(base: dict[str, Any], grid: dict[str, list[Any]]) -> dict[str, Any
     return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": slidernet.__version__}))
 
 
+def _clear_folder(folder: Path) -> None:
+    """Remove what a sweep writes in ``folder`` (``overwrite``): its identity, points and result."""
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"The output directory {str(folder)!r} is a file; name a folder.")
+    for name in (_SWEEP_JSON, "result.nc"):
+        (folder / name).unlink(missing_ok=True)
+    shutil.rmtree(folder / "points", ignore_errors=True)
+
+
 def _check_folder(folder: Path, identity: dict[str, Any], resume: bool) -> int | None:
     """Refuse a folder that holds another sweep (or none, on resume); return the stored seed on resume."""
     path = folder / _SWEEP_JSON
     if not resume:
+        if path.exists() and (folder / "result.nc").exists():
+            raise OutputError(f"{str(folder)!r} holds a finished sweep; it is not replaced silently. Replace it "
+                              "with --overwrite, or use another output directory.")
         if path.exists():
-            raise CheckpointError(f"{str(folder)!r} holds a sweep already. Continue it with --resume "
-                                  f"(resume=True), or use another output directory.")
+            raise CheckpointError(f"{str(folder)!r} holds an interrupted sweep. Continue it with --resume, "
+                                  "replace it with --overwrite, or use another output directory.")
         return None
     if not path.exists():
         raise CheckpointError(f"Nothing to resume in {str(folder)!r}: it has no {_SWEEP_JSON}.")
@@ -411,23 +437,7 @@ def _run_point(cfg: Config, where: Path | None, resume: bool, done: Callable[[in
     """One point: a plain run, or its run in ``where`` (resumed, or read back if it has finished)."""
     if where is None:
         return runner.run(cfg, progress=False, on_realization=done, **execution)
-    # slidernet.store keeps a run's checkpoint folder until its result.nc is written.
-    unfinished = (where / "checkpoint").exists()
-    if resume and not unfinished and (where / "result.nc").exists():
-        ds = read_result(where / "result.nc")
-        expected = json.loads(json.dumps(cfg.model_dump(mode="json", exclude={"execution"})))
-        if json.loads(ds.attrs["config"]) != expected:
-            raise CheckpointError(f"Cannot resume: {str(where / 'result.nc')!r} holds a run of another "
-                                  f"configuration than this point's.")
-        for r in range(cfg.realizations):
-            done(r)
-        return ds
-    ds = runner.run(cfg, progress=False, on_realization=done, out=where, resume=resume and unfinished,
-                    **execution)
-    # The runner opens its result file lazily: read it and let the file go.
-    ds.load()
-    ds.close()
-    return ds
+    return runner.run_in(cfg, where, resume=resume, on_realization=done, **execution)
 
 
 def _counter(bar: tqdm, on_realization: Callable[[int, int], None] | None, i: int) -> Callable[[int], None]:

@@ -13,7 +13,7 @@ import xarray as xr
 
 import slidernet
 from slidernet import runner
-from slidernet.errors import CheckpointError, ConfigError, RunInterrupted
+from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
 from slidernet.io import read_result
 from slidernet.sweep import _dim_names, parse_grid, parse_set, sweep
 
@@ -244,12 +244,17 @@ def test_out_folder_holds_every_point_and_the_result(tmp_path):
     point = read_result(tmp_path / "points" / "1" / "result.nc")
     xr.testing.assert_identical(point["n"], ds["n"].sel(sigma_theta=1e-6, drop=True))
     xr.testing.assert_identical(ds, sweep(BASE, grid, **ONE).assign_attrs(execution=ds.attrs["execution"]))
-    with pytest.raises(CheckpointError, match="holds a sweep already"):
+    with pytest.raises(OutputError, match="holds a finished sweep; it is not replaced silently"):
         sweep(BASE, grid, out=tmp_path, **ONE)
     with pytest.raises(CheckpointError, match=r"the grid differs"):
         sweep(BASE, {"driver.sigma_theta": [1e-7, 3e-6]}, out=tmp_path, resume=True, **ONE)
     with pytest.raises(CheckpointError, match="Nothing to resume"):
         sweep(BASE, grid, out=tmp_path / "elsewhere", resume=True, **ONE)
+    # --overwrite replaces a finished sweep with another one.
+    other = {"driver.sigma_theta": [2e-7, 1e-6]}
+    replaced = sweep(BASE, other, out=tmp_path, overwrite=True, **ONE)
+    xr.testing.assert_identical(read_result(tmp_path / "result.nc"), replaced)
+    assert replaced["sigma_theta"].values.tolist() == [2e-7, 1e-6]
 
 
 def test_a_killed_sweep_resumes_to_the_same_bits(tmp_path, monkeypatch):
@@ -285,13 +290,13 @@ def test_a_killed_sweep_resumes_to_the_same_bits(tmp_path, monkeypatch):
         np.testing.assert_array_equal(resumed[name].values, fresh[name].values, err_msg=name)
 
 
-def test_the_paper_figure_3b_sweep_fills_its_progress_bar():
+def test_the_paper_figure_3b_sweep_fills_its_progress_bar(tmp_path):
     # paper.reproduce drives one bar over every job; the sweep of panel b must add exactly its jobs' cost.
     from slidernet.paper import _config, _Job, _Runner
 
     jobs = [_Job(f"sweep_sigma_theta={s:g}", _config(s, 50, 2, 201, observables=("n",))) for s in (1e-7, 1e-6)]
-    bar_owner = _Runner(jobs, progress=True)
-    ds = bar_owner.sweep(jobs, "driver.sigma_theta")
+    bar_owner = _Runner(jobs, progress=True, runs=tmp_path, resume=False)
+    ds = bar_owner.sweep(jobs, "driver.sigma_theta", "fig3b")
     assert bar_owner.bar.n == bar_owner.bar.total == sum(j.cost for j in jobs)
     assert ds["sigma_theta"].values.tolist() == [1e-7, 1e-6]
     bar_owner.close()
