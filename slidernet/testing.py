@@ -12,7 +12,9 @@ Plugins can advertise parameters that make a good example through two
 optional attributes of their factory: ``example_params`` (a dict of keyword
 arguments) and, for distributions, ``example_mu_d`` (a mu_d for which the
 example makes sense; 0.5 when absent). slidernet's own contract test runs
-every registered plugin with them.
+every registered plugin with them. The two built-ins that read a file, the
+``empirical`` distribution and the ``series`` driver, take their example from
+the small files shipped in ``slidernet/data`` (see :func:`example_of`).
 
 Examples
 --------
@@ -30,6 +32,7 @@ import inspect
 import math
 import random
 from collections.abc import Callable, Mapping
+from importlib.resources import files
 from typing import Any
 
 import numpy as np
@@ -41,6 +44,7 @@ __all__ = [
     "PluginContractError",
     "check_distribution",
     "check_driver",
+    "example_file",
     "example_of",
 ]
 
@@ -52,8 +56,36 @@ class PluginContractError(SlidernetError, AssertionError):
     """A plugin breaks the contract of ``plugins/README.md``."""
 
 
+def example_file(name: str) -> str:
+    """The path of an example data file shipped in ``slidernet/data`` (see its README.md).
+
+    >>> from pathlib import Path
+    >>> Path(example_file("mu_s_example.txt")).is_file()
+    True
+    """
+    return str(files("slidernet").joinpath("data", name))
+
+
+def _file_examples() -> list[tuple[Any, dict[str, Any]]]:
+    """Examples of the built-ins that read a file, which cannot declare a path of their own.
+
+    The path depends on where slidernet is installed, so it is looked up when asked for.
+    """
+    from slidernet.distributions import Empirical
+    from slidernet.drivers import Series
+
+    return [
+        (Empirical, {"path": example_file("mu_s_example.txt")}),
+        # kappa of steel (1/K) about T0 = 15 degC, one sample (an hour) per tau_th.
+        (Series, {"path": example_file("temperature_example.csv"), "kappa": 1.2e-5, "T0": 15.0, "tau_th": 1.0}),
+    ]
+
+
 def example_of(factory: Callable[..., Any]) -> dict[str, Any] | None:
     """The ``example_params`` a factory advertises, or None.
+
+    The built-ins ``empirical`` and ``series`` read a file: their example
+    points at the files shipped in ``slidernet/data``.
 
     >>> class Law:
     ...     example_params = {"mean": 0.6}
@@ -61,10 +93,14 @@ def example_of(factory: Callable[..., Any]) -> dict[str, Any] | None:
     {'mean': 0.6}
     >>> example_of(print) is None
     True
+    >>> from slidernet.drivers import Series
+    >>> sorted(example_of(Series))
+    ['T0', 'kappa', 'path', 'tau_th']
     """
     params = getattr(factory, "example_params", None)
     if params is None:
-        return None
+        # Identity, not a dict lookup: a factory need not be hashable.
+        return next((dict(p) for cls, p in _file_examples() if factory is cls), None)
     if not isinstance(params, Mapping):
         raise PluginContractError(f"{_label(factory)}: 'example_params' must be a dict of keyword arguments, "
                                   f"not {type(params).__name__}.")

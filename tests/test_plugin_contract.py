@@ -11,15 +11,17 @@ plugin without ``example_params`` is skipped, saying so.
 from __future__ import annotations
 
 import random
+import re
 import sys
 from importlib.metadata import EntryPoint
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 import pytest
 
 import slidernet
-from slidernet import PluginError, UnknownPluginError, registry
+from slidernet import PluginError, UnknownPluginError, distributions, drivers, registry
 from slidernet.cli import main
 from slidernet.config import load_config
 from slidernet.testing import (
@@ -27,6 +29,7 @@ from slidernet.testing import (
     PluginContractError,
     check_distribution,
     check_driver,
+    example_file,
     example_of,
 )
 from tests.conftest import FixedThetas, make_config
@@ -65,6 +68,43 @@ def test_driver_follows_the_contract(name):
     check_driver(factory, params, name=name)
     ds = slidernet.run(make_config(**TINY, driver={"name": name, **params}))
     assert np.isfinite(ds["x_G"].values).all()
+
+
+BUILTINS = [(registry.distributions, name) for name in distributions.BUILTINS] + [
+    (registry.drivers, name) for name in drivers.BUILTINS]
+
+
+@pytest.mark.parametrize(("reg", "name"), BUILTINS, ids=[name for _, name in BUILTINS])
+def test_every_builtin_has_an_example_so_the_contract_test_never_skips_it(reg, name):
+    # The file-reading built-ins (empirical, series) used to be skipped on every run.
+    params = example_of(reg.get(name))
+    assert params is not None
+    if "path" in params:
+        assert Path(params["path"]).is_file()
+        assert Path(params["path"]).parent == Path(example_file("README.md")).parent
+
+
+def test_the_shipped_example_files_are_what_their_note_says(tmp_path, monkeypatch):
+    # slidernet/data/README.md holds the script that made them: rerun it and compare bytes.
+    note = Path(example_file("README.md")).read_text(encoding="utf-8")
+    script = re.search(r"```python\n(.*?)```", note, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(compile(script, "slidernet/data/README.md", "exec"), {})
+    for name in ("mu_s_example.txt", "temperature_example.csv"):
+        assert (tmp_path / name).read_bytes() == Path(example_file(name)).read_bytes(), name
+
+
+def test_the_shipped_examples_are_read_as_the_note_describes():
+    # Comment lines skipped, every value kept (truncation below mu_d happens later).
+    values = np.loadtxt(example_file("mu_s_example.txt"))
+    assert values.size == 200
+    law = distributions.Empirical(**example_of(distributions.Empirical))
+    assert law.values.tolist() == sorted(values.tolist())
+    # The header line skipped; 8 days of hourly samples cover 192 steps of tau_th = 1 h.
+    series = drivers.Series(**example_of(drivers.Series))
+    assert series.covered_steps == 192
+    theta = series.thetas(np.random.default_rng(0), 24)
+    np.testing.assert_allclose(theta / 1.2e-5 + 15.0, series.temperature[:25], rtol=0, atol=1e-9)
 
 
 # --------------------------------------------------------------------------
