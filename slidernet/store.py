@@ -89,10 +89,10 @@ class RunStore:
             raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
         run_json = self.dir / "run.json"
         result = out / "result.nc"
-        if result.exists() and not run_json.exists() and not self.overwrite:
+        if result.exists() and not run_json.exists() and not (self.overwrite or self.resume):
             raise OutputError(
                 f"{str(out)!r} holds a finished result ({str(result)!r}); it is not replaced silently. "
-                "Use --overwrite (overwrite=True) to replace it, or another output directory."
+                "Use --overwrite to replace it, or another output directory."
             )
         if run_json.exists() and self.overwrite and not self.resume:
             shutil.rmtree(self.dir)  # asked for: the interrupted run there is replaced

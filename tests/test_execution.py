@@ -8,12 +8,6 @@ memory, and after any number of kills and resumes.
 from __future__ import annotations
 
 import json
-import os
-import signal
-import subprocess
-import sys
-import time
-from pathlib import Path
 
 import netCDF4
 import numpy as np
@@ -21,7 +15,6 @@ import pytest
 import xarray as xr
 
 import slidernet
-from slidernet.config import tomllib
 from slidernet.errors import CheckpointError, ConfigError
 from slidernet.io import read_result, write_netcdf
 
@@ -87,91 +80,7 @@ def test_more_realizations_than_a_reduction_chunk(tmp_path):
         assert nc["n"].chunking() == [1024, mem.sizes["t"]]
 
 
-def _write_toml(path: Path, cfg: dict) -> Path:
-    lines = []
-
-    def emit(table: dict, prefix: str) -> None:
-        scalars = {k: v for k, v in table.items() if not isinstance(v, dict)}
-        if prefix:
-            lines.append(f"[{prefix}]")
-        for k, v in scalars.items():
-            lines.append(f"{k} = {json.dumps(v)}")
-        for k, v in table.items():
-            if isinstance(v, dict):
-                emit(v, f"{prefix}.{k}" if prefix else k)
-
-    emit(cfg, "")
-    path.write_text("\n".join(lines) + "\n")
-    assert tomllib.loads(path.read_text()) == cfg
-    return path
-
-
-# A run of a few seconds, made of realizations long enough (about 1 s, 4e5
-# slips each) to be caught in the middle: an 8 x 8 triangular lattice with
-# the event catalogue and the network tilt test.
-LONG = {**LATTICE, "realizations": 4, "steps": 200, "network": {"kind": "triangular", "shape": [8, 8],
-                                                                  "Ntilde": 1e-7},
-        "execution": {"checkpoint_every": 0.2}}
-
-
-def _start(config: Path, out: Path, *extra: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out),
-                             "--no-progress", *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
-
-
-def _wait_for(pattern: str, folder: Path, proc: subprocess.Popen, timeout: float = 120.0) -> None:
-    t0 = time.monotonic()
-    while not list(folder.glob(pattern)):
-        assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() - t0 < timeout, f"no {pattern} after {timeout} s"
-        time.sleep(0.05)
-
-
-@pytest.fixture(scope="module")
-def long_reference():
-    return slidernet.run(LONG, workers=1)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("workers", ["1", "2"], ids=["one-worker", "two-workers"])
-def test_resume_after_kill_9_gives_the_same_bits(tmp_path, long_reference, workers):
-    config = _write_toml(tmp_path / "long.toml", LONG)
-    out = tmp_path / "out"
-    proc = _start(config, out, "--workers", workers)
-    _wait_for("checkpoint/partial-*.npz", out, proc)
-    os.killpg(proc.pid, signal.SIGKILL)  # the whole session: workers die too, as in a machine failure
-    proc.wait()
-    assert not (out / "result.nc").exists()
-    for f in (out / "checkpoint").glob("*.npz"):
-        with np.load(f, allow_pickle=False) as z:  # plain numeric files: no pickle needed to read them
-            [z[k] for k in z.files]
-    done = subprocess.run([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out),
-                           "--no-progress", "--resume", "--workers", "2"], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    assert_same_bits(read_result(out / "result.nc"), long_reference)
-    assert not (out / "checkpoint").exists()
-
-
-@pytest.mark.slow
-def test_ctrl_c_saves_and_says_how_to_resume(tmp_path, long_reference):
-    config = _write_toml(tmp_path / "long.toml", LONG)
-    out = tmp_path / "out"
-    proc = _start(config, out, "--workers", "1")
-    _wait_for("checkpoint/partial-*.npz", out, proc)
-    os.killpg(proc.pid, signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
-    assert "--resume" in err and "interrupted" in err
-    assert not (out / "result.nc").exists()
-    assert list((out / "checkpoint").glob("*.npz"))
-    assert not list((out / "checkpoint").glob("*.tmp"))
-    # Without --resume the interrupted run is refused, not overwritten.
-    again = subprocess.run([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out)],
-                           capture_output=True, text=True)
-    assert again.returncode == 2 and "--resume" in again.stderr
-    with slidernet.run(LONG, out=out, resume=True, workers=1) as ds:
-        assert_same_bits(ds.load(), long_reference)
+# Interrupts (Ctrl-C, SIGTERM, kill -9 inside running realizations) are tested in test_interrupts.py.
 
 
 def test_resume_refuses_another_config(tmp_path):
