@@ -110,3 +110,47 @@ def test_presets_use_the_captions_parameters():
         assert len(p.fig3b_sigmas) >= 8
         assert p.fig4_sigma_theta == 1e-6
         assert set(p.fig4_mu_ds) == {0.5, 0.4} and set(p.fig4_ratios) == {0.1, 0.2, 0.3}
+
+
+def test_an_interrupted_reproduction_resumes_to_the_same_figures(tmp_path, tiny_output, monkeypatch):
+    import signal
+
+    from slidernet import paper, runner
+    from slidernet.errors import CheckpointError, OutputError, RunInterrupted
+
+    real_run_in = paper.run_in
+    calls = []
+
+    def stopped_at_the_third_run(*args, **kwargs):
+        calls.append(args[1])
+        if len(calls) == 3:  # figures 1 and 2 are done; panel 3a is running
+            raise RunInterrupted("stopped", signal.SIGTERM)
+        return real_run_in(*args, **kwargs)
+
+    out = tmp_path / "paper"
+    monkeypatch.setattr(paper, "run_in", stopped_at_the_third_run)
+    with pytest.raises(RunInterrupted, match=r"slidernet paper --out .* --resume") as info:
+        reproduce(out, progress=False, _preset=TINY)
+    assert info.value.signum == signal.SIGTERM
+    with pytest.raises(OutputError, match="interrupted reproduction"):
+        reproduce(out, progress=False, _preset=TINY)
+    monkeypatch.setattr(paper, "run_in", real_run_in)
+    real_run = runner.run
+    computed = []
+
+    def counted(cfg, *args, **kwargs):
+        computed.append(kwargs["out"].name)
+        return real_run(cfg, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run", counted)
+    reproduce(out, progress=False, resume=True, _preset=TINY)
+    assert not set(computed) & {p.name for p in calls[:2]}  # the finished runs are read back
+    assert calls[2].name in computed
+    reference, _ = tiny_output
+    for name in EXPECTED:
+        a, b = read_result(out / name), read_result(reference / name)
+        for var in a.data_vars:
+            np.testing.assert_array_equal(a[var].values, b[var].values, err_msg=f"{name}:{var}")
+    assert not (out / "runs").exists()
+    with pytest.raises(CheckpointError, match="finished"):
+        reproduce(out, progress=False, resume=True, _preset=TINY)
