@@ -34,7 +34,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 
 from slidernet import registry, units
 from slidernet.distributions import TruncatedBelow
-from slidernet.errors import ConfigError
+from slidernet.errors import ConfigError, SlidernetError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -297,6 +297,12 @@ def is_scheduler_address(value: object) -> bool:
     return bool(sep) and scheme in _SCHEDULER_SCHEMES and bool(rest)
 
 
+#: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
+NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
+Observable = Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events",
+                     "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
+
+
 class Config(_Strict):
     """A full run: what to simulate, for how long, and what to record.
 
@@ -316,7 +322,7 @@ class Config(_Strict):
     steps: Annotated[int, Field(ge=1)]
     record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = "log"
     log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = 20
-    observables: list[Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events"]] = Field(
+    observables: list[Observable] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"]
     )
     mu_eff_at: Literal["auto", "rearrangements", "records"] = "auto"
@@ -385,6 +391,44 @@ class Config(_Strict):
                              "use 'solver.kernel = \"auto\"' or '\"csr\"'")
         return self
 
+    @model_validator(mode="after")
+    def _network_observables_can_be_recorded(self) -> Config:
+        asked = [name for name in NETWORK_OBSERVABLES if name in self.observables]
+        if not asked:
+            return self
+        dim, pair = self._network_dim_and_pair()
+        if pair:
+            raise ValueError(
+                f"the observables {asked} are recorded by the network kernels, and this two-slider scene runs on "
+                f"the 'pair' kernel; set 'solver.kernel = \"csr\"' to record them"
+            )
+        if "y_G" in asked and dim == 1:
+            raise ValueError(
+                f"the 'y_G' observable (the centre of mass along y) needs a 2D network; this {self.network.kind} "
+                f"network is 1D (its displacement is x_G)"
+            )
+        return self
+
+    def _network_dim_and_pair(self) -> tuple[int | None, bool]:
+        """(dimension, runs on the pair kernel) of the network, reading a graph file only if there is one."""
+        net = self.network
+        if net.kind == "graph":
+            from slidernet.solver import build_network
+
+            try:
+                built = build_network(self)
+            except (SlidernetError, OSError):
+                return None, False  # building the scene reports the file itself
+            pair = built.is_two_slider() and self.solver.kernel in ("auto", "pair")
+            return built.dim, pair
+        dim = 1 if net.kind in ("two_slider", "chain") else 2
+        defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.f_ext
+        two = net.kind == "two_slider" or (net.kind == "chain" and net.n == 2)
+        # solver.Scene picks the pair kernel for the paper's scene unless the event catalogue is asked for.
+        pair = self.solver.kernel == "pair" or (
+            self.solver.kernel == "auto" and two and defaults and "events" not in self.observables)
+        return dim, pair
+
     def distribution(self) -> TruncatedBelow:
         """The mu_s distribution, truncated below mu_d (built once, cached)."""
         if self._distribution is None:
@@ -402,18 +446,29 @@ def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
     factory = reg.get(spec.name)
     params = spec.params
     try:
-        inspect.signature(factory).bind(**params)
+        signature = inspect.signature(factory)
+    except (TypeError, ValueError):  # pragma: no cover - builtins without signature
+        signature = None
+    try:
+        if signature is not None:
+            signature.bind(**params)
     except TypeError as exc:
-        try:
-            names = ", ".join(repr(p) for p in inspect.signature(factory).parameters)
-        except (TypeError, ValueError):  # pragma: no cover - builtins without signature
-            names = "?"
+        accepted = signature.parameters
+        names = ", ".join(repr(p) for p in accepted)
+        # Name only the keys at fault: listing every given key put the right ones among the refused.
+        takes_any = any(p.kind is p.VAR_KEYWORD for p in accepted.values())
+        unknown = [] if takes_any else sorted(set(params) - set(accepted))
+        missing = [name for name, p in accepted.items() if p.default is p.empty
+                   and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and name not in params]
+        if unknown:
+            fault = f"does not accept {unknown}" + (f" and needs {missing}" if missing else "")
+        elif missing:
+            fault = f"does not accept the parameters given: it needs {missing}"
+        else:  # pragma: no cover - positional-only parameters and the like
+            fault = f"does not accept these parameters: {exc}"
         raise ConfigError(
-            f"The '{field}' field: the {reg.kind} {spec.name!r} does not accept "
-            f"{sorted(params)}: {exc}. Its parameters are {names}."
+            f"The '{field}' field: the {reg.kind} {spec.name!r} {fault}. Its parameters are {names}."
         ) from None
-    except ValueError:  # pragma: no cover - no introspectable signature
-        pass
     try:
         return factory(**params)
     except ConfigError as exc:

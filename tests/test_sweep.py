@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import importlib
 import json
+import re
 from typing import Any
 
 import numpy as np
@@ -230,6 +231,18 @@ def no_work(monkeypatch):
 def test_refused_before_any_work(no_work, base, grid, match):
     with pytest.raises(ConfigError, match=match):
         sweep(base, grid, **ONE)
+
+
+@pytest.mark.parametrize(("grid", "refused"), [
+    ({"driver.sigma_theta": [1e-7, 1e-6], "driver.sigma": [1.0]}, ["sigma"]),
+    ({"friction.static.std": [0.01, 0.02], "friction.static.stdd": [0.01]}, ["stdd"]),
+], ids=["driver", "distribution"])
+def test_a_bad_key_swept_beside_a_good_one_is_the_only_one_refused(no_work, grid, refused):
+    # The message used to list every key of the plugin's table, the right one among them.
+    with pytest.raises(ConfigError, match=r"^Sweep point 0 \(") as info:
+        sweep(BASE, grid, **ONE)
+    listed = re.search(r"does not accept (\[.*?\])", str(info.value)).group(1)
+    assert listed == str(refused), str(info.value)
 
 
 # ---------------------------------------------------------------------------
