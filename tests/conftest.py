@@ -8,10 +8,15 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from slidernet import registry
 from slidernet.config import load_config
 from slidernet.solver import Realization, Scene
+
+# No hypothesis example may fail for taking long: the suite runs on slow and loaded machines too.
+settings.register_profile("slidernet", deadline=None)
+settings.load_profile("slidernet")
 
 # MODEL.md section 5, as a dict, exactly as written there.
 REFERENCE: dict[str, Any] = {

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import re
-import time
 from fractions import Fraction
 
 import numpy as np
@@ -220,14 +219,10 @@ def test_mu_max_moments_median_gap():
     np.testing.assert_allclose(mean - median, ref - median, rtol=0, atol=1e-11)
 
 
-def test_mu_max_moments_shape_monotonicity_and_speed():
+def test_mu_max_moments_shape_and_monotonicity():
+    # Its speed (~0.03 s for 100 values of n) is not asserted: a test never races the machine.
     n = np.unique(np.round(np.logspace(0, 9, 100)))
-    mu_max_moments(NARROW, n[:3])  # build the cached quadrature rule
-    start = time.perf_counter()
     mean, std = mu_max_moments(NARROW, n)
-    elapsed = time.perf_counter() - start
-    # Budget 0.5 s for ~100 values of n (measured ~0.03 s); 4x margin for slow CI.
-    assert elapsed < 2.0
     assert mean.shape == std.shape == n.shape
     assert (np.diff(mean) > 0).all() and (np.diff(std) < 0).all()
     grid_mean, grid_std = mu_max_moments(HEAVY, np.array([[0, 5, 5], [1e9, 0, 5]]))
