@@ -1,8 +1,10 @@
 """Checkpoints of one realization in the middle of its run, resumed to the same bits.
 
 Between two calls of :meth:`Realization.advance` a realization is at a clean
-point: its whole state is in arrays and in the states of its three random
-streams. :func:`save_realization` writes that state to one ``.npz`` file
+point: its whole state is in arrays, in the states of its random streams and
+in the surplus of its threshold streams (the accepted draws a
+:class:`~slidernet.distributions.TruncatedStream` has drawn but not yet
+handed out). :func:`save_realization` writes that state to one ``.npz`` file
 (numpy's zip of ``.npy`` arrays; nothing is pickled) and
 :func:`load_realization` rebuilds the realization from its scene and seed and
 overwrites its state from the file. Advancing the loaded realization gives
@@ -16,12 +18,15 @@ File layout (keys of the ``.npz``; every array numeric):
     ``scene`` (a fingerprint of the scene: kernel, sizes, batch, ... and
     digests of K, g, the loads and the recorded times), ``thetas`` (a digest
     of theta(t_q)), ``rngs`` (the ``bit_generator.state`` of the driver,
-    thresholds and tilt streams), ``step`` and ``n`` (for information),
+    thresholds, tilt and tilt_uniforms streams), ``step`` and ``n`` (for information),
     ``tilted``, ``events_complete``, ``ev_rows`` and ``numpy``.
 ``state/<name>``
     The arrays of the realization: ``ist``, ``fst``, ``mu``, ``mu_buf``,
     ``tmu``, ``tu``, and for the network kernels ``a``, ``u``, ``hp``,
     ``hpos``, ``hv``, ``aval_hist``, ``node_slips``.
+``surplus/<name>``
+    float64, the surplus of the ``thresholds`` and ``tilt`` threshold
+    streams (``Realization.draws``), in order (version 2 on).
 ``out/<name>``
     The records written so far (every key of ``Realization.out``).
 ``events/buffer_i``, ``events/buffer_f``
@@ -49,7 +54,8 @@ from slidernet.io import atomic_output
 from slidernet.solver import Realization, Scene
 
 FORMAT = "slidernet-checkpoint"
-VERSION = 1
+# 2: the threshold streams' surplus (surplus/<name>) and the tilt_uniforms stream.
+VERSION = 2
 
 # Arrays whose shape and dtype are fixed by the scene: copied into the fresh realization's own.
 _FIXED = ("ist", "fst", "mu")
@@ -57,13 +63,13 @@ _FIXED_NETWORK = ("a", "u", "hp", "hpos", "hv", "aval_hist", "node_slips")
 # Draw buffers: their length changes when they are refilled.
 _BUFFERS = ("mu_buf", "tmu", "tu")
 # Attributes written to the file by name (arrays above, or special handling below).
-_SAVED = {*_FIXED, *_FIXED_NETWORK, *_BUFFERS, "out", "rngs", "ev_i", "ev_f", "_event_chunks",
+_SAVED = {*_FIXED, *_FIXED_NETWORK, *_BUFFERS, "out", "rngs", "draws", "ev_i", "ev_f", "_event_chunks",
           "events_complete", "_tilted"}
 # Attributes the constructor rebuilds, and why that is exact.
 _REBUILT = {
     "scene": "passed to load_realization",
     "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
-    "_mu_batches": "a generator reading rngs['thresholds'], whose state is restored in place",
+    "_mu_batches": "a generator reading draws['thresholds'], whose surplus and Generator are restored in place",
     "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
 }
 
@@ -143,6 +149,8 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
     arrays = {"header": np.frombuffer(text.encode("utf-8"), dtype=np.uint8)}
     for name in _FIXED + _BUFFERS + (_FIXED_NETWORK if network else ()):
         arrays[f"state/{name}"] = getattr(real, name)
+    for name, stream in real.draws.items():
+        arrays[f"surplus/{name}"] = stream.surplus
     for name, values in real.out.items():
         arrays[f"out/{name}"] = values
     if network:
@@ -380,8 +388,14 @@ def _restore(real: Realization, header: dict[str, Any], arrays: dict[str, np.nda
     if set(header["rngs"]) != set(real.rngs):
         raise ValueError(f"its streams are {sorted(header['rngs'])}, a realization's are {sorted(real.rngs)}")
     for name, rng in real.rngs.items():
-        # In place: the threshold batches come from a generator holding this very Generator.
+        # In place: the threshold streams hold these very Generators.
         rng.bit_generator.state = header["rngs"][name]
+    saved_streams = {key.removeprefix("surplus/") for key in arrays if key.startswith("surplus/")}
+    if saved_streams != set(real.draws):
+        raise ValueError(f"its threshold streams are {sorted(saved_streams)}, a realization's are "
+                         f"{sorted(real.draws)}")
+    for name, stream in real.draws.items():
+        stream.restore(_take(arrays, f"surplus/{name}", dtype=np.float64, ndim=1))
 
 
 def _fsync_folder(folder: Path) -> None:

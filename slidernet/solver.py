@@ -2,10 +2,10 @@
 
 Data flow for one realization (see ARCHITECTURE.md)::
 
-    SeedSequence child r --spawn(3)--> [driver, thresholds, tilt]
+    SeedSequence child r --spawn(3)--> [driver, thresholds, tilt]; tilt --spawn(1)--> [tilt_uniforms]
     driver.thetas(rng_driver, steps)      -> theta(t_q), q = 0..steps
-    dist.sample(rng_thresholds, N)        -> initial mu_s, then batches
-    kernel (pair or csr) over the thetas  -> records at the recorded times
+    TruncatedStream(dist, rng_thresholds) -> initial mu_s, then one per slip, handed out in batches
+    kernel (pair, csr or vec)             -> records at the recorded times
 
 No time stepping: within each linear segment of theta the kernel jumps from
 one rearrangement to the next by solving eq. `critique` exactly.
@@ -22,6 +22,7 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.config import Config
+from slidernet.distributions import TruncatedStream
 from slidernet.errors import AvalancheError, ConfigError, TiltTestError
 from slidernet.network import Network
 from slidernet.registry import checked_output
@@ -233,13 +234,18 @@ def tilt_avalanche_cap(n_nodes: int) -> int:
 
 
 def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random.Generator]:
-    """The three independent streams of one realization, in their documented order.
+    """The independent random streams of one realization, in their documented order.
 
     ``seed_seq.spawn(3)`` gives, in order: the driver, the thresholds of the
-    horizontal evolution, and the virtual tilt test. The tilt test never
-    touches the other two, so requesting ``mu_eff`` leaves n, mu_max and x_G
-    unchanged to the bit. The same ``seed_seq`` always gives the same
-    streams, even after it has been spawned from.
+    horizontal evolution, and the virtual tilt test's thresholds. The tilt
+    test's uniforms, ``"tilt_uniforms"``, come from the first child of the
+    tilt child (spawn key ``seed_seq.spawn_key + (2, 0)``): the tilt test reads
+    thresholds and uniforms in proportions that depend on the state, so each
+    kind needs a stream of its own for its values to be a function of the
+    seed alone. The tilt test never touches the first two streams, so
+    requesting ``mu_eff`` leaves n, mu_max and x_G unchanged to the bit. The
+    same ``seed_seq`` always gives the same streams, even after it has been
+    spawned from.
 
     Examples
     --------
@@ -254,10 +260,13 @@ def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random
     # of its seed alone, however often that seed is used (reruns, comparisons).
     pristine = np.random.SeedSequence(seed_seq.entropy, spawn_key=seed_seq.spawn_key,
                                       pool_size=seed_seq.pool_size)
-    return {
-        name: np.random.Generator(np.random.PCG64(child))
-        for name, child in zip(names, pristine.spawn(3), strict=True)
-    }
+    children = pristine.spawn(3)
+    streams = {name: np.random.Generator(np.random.PCG64(child))
+               for name, child in zip(names, children, strict=True)}
+    # Spawning from the tilt child leaves its own Generator (made above from its
+    # entropy pool) as it always was: the tilt thresholds keep their stream.
+    streams["tilt_uniforms"] = np.random.Generator(np.random.PCG64(children[2].spawn(1)[0]))
+    return streams
 
 
 def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
@@ -267,9 +276,13 @@ def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
     return thetas
 
 
-def horizontal_draws(scene: Scene, rngs: dict[str, np.random.Generator]) -> tuple[
-        np.ndarray, np.ndarray, Iterator[np.ndarray]]:
+def horizontal_draws(scene: Scene, rngs: dict[str, np.random.Generator],
+                     stream: TruncatedStream | None = None) -> tuple[np.ndarray, np.ndarray, Iterator[np.ndarray]]:
     """The draws of a realization's horizontal evolution, in the order the solver reads them.
+
+    The thresholds are the values of one :class:`TruncatedStream` on the
+    thresholds Generator: the N initial ones, then one per slip. The batches
+    only cut that sequence into pieces; their size never changes a value.
 
     Parameters
     ----------
@@ -277,6 +290,9 @@ def horizontal_draws(scene: Scene, rngs: dict[str, np.random.Generator]) -> tupl
         The scene.
     rngs : dict of str to Generator
         The realization's streams (:func:`realization_streams`).
+    stream : TruncatedStream, optional
+        The thresholds stream to read (the realization's own); by default a
+        new one on ``rngs["thresholds"]``, which must then be untouched.
 
     Returns
     -------
@@ -290,12 +306,14 @@ def horizontal_draws(scene: Scene, rngs: dict[str, np.random.Generator]) -> tupl
         :mod:`slidernet.speed_error`) read them to run the same realization.
     """
     thetas = draw_thetas(scene, rngs["driver"]) / scene.network.Ntilde
-    dist = scene.distribution
-    mu = dist.sample(rngs["thresholds"], scene.network.n_nodes).astype(np.float64)
+    if stream is None:
+        stream = TruncatedStream(scene.distribution, rngs["thresholds"])
+    # A copy: the kernels write the current thresholds in place.
+    mu = stream.take(scene.network.n_nodes).copy()
 
     def batches() -> Iterator[np.ndarray]:
         while True:
-            yield dist.sample(rngs["thresholds"], scene.batch)
+            yield stream.take(scene.batch)
 
     return thetas, mu, batches()
 
@@ -320,6 +338,29 @@ class Realization:
     in :meth:`advance`. Between calls the state is fully relaxed (every node
     stable), which the property tests check through :meth:`forces`.
 
+    Every value drawn is a function of ``seed_seq`` alone, never of
+    ``solver.batch`` (which only sets how many values wait in the kernels'
+    buffers) nor of where the kernels stop. The four streams of
+    :func:`realization_streams` are read in this order:
+
+    1. ``driver``: ``driver.thetas(rng, steps)``, once.
+    2. ``thresholds``: a :class:`~slidernet.distributions.TruncatedStream`
+       (``draws["thresholds"]``): the plugin's ``sample(rng, RAW_CHUNK)``
+       called again and again with the fixed size ``RAW_CHUNK``, the values
+       at or below mu_d dropped, the rest laid end to end. The first N values
+       are the initial thresholds (node order), then one value per slip, in
+       the order of the slips.
+    3. ``tilt``: another ``TruncatedStream`` (``draws["tilt"]``), the same way:
+       the thresholds the tilt tests redraw, in the order the tests (one
+       after the other) read them.
+    4. ``tilt_uniforms``: ``rng.random()``, one value per creep branch of a
+       tilt test (the uniform force of the appendix), in the order the tests
+       read them.
+
+    The tilt test reads thresholds and uniforms in proportions that depend
+    on the state, so each kind has its own stream; buffers of either may be
+    topped up at any time without changing what the other reads.
+
     Parameters
     ----------
     scene : Scene
@@ -331,12 +372,16 @@ class Realization:
     def __init__(self, scene: Scene, seed_seq: np.random.SeedSequence) -> None:
         self.scene = scene
         self.rngs = realization_streams(seed_seq)
-        self.thetas, self.mu, self._mu_batches = horizontal_draws(scene, self.rngs)
+        # One stream of accepted thresholds per Generator that draws them: its
+        # surplus is state (saved by checkpoints), and where the kernels stop to
+        # refill, or how much they ask for, never changes a value.
+        self.draws = {name: TruncatedStream(scene.distribution, self.rngs[name])
+                      for name in ("thresholds", "tilt")}
+        self.thetas, self.mu, self._mu_batches = horizontal_draws(scene, self.rngs, self.draws["thresholds"])
         self.mu_buf = next(self._mu_batches)
-        dist = scene.distribution
         if scene.tilt_at is not None:
-            self.tmu = dist.sample(self.rngs["tilt"], scene.batch)
-            self.tu = self.rngs["tilt"].random(scene.batch)
+            self.tmu = self.draws["tilt"].take(scene.batch)
+            self.tu = self.rngs["tilt_uniforms"].random(scene.batch)
         else:
             self.tmu = np.empty(0)
             self.tu = np.empty(0)
@@ -541,19 +586,23 @@ class Realization:
             self._refill_tilt()
 
     def _refill_tilt(self) -> None:
-        """Top up the tilt stream's buffers after a test ran out of one of them.
+        """Top up the tilt test's buffers after a test ran out of one of them.
 
-        A buffer with fewer than ``batch`` unread draws gets a batch
-        (thresholds first). If both still held a batch, one test needed more
-        than that (a long avalanche): both grow, so that the retry gets further.
+        The thresholds come from the tilt stream (``draws["tilt"]``, a
+        :class:`TruncatedStream` on ``rngs["tilt"]``), the uniforms from
+        ``rngs["tilt_uniforms"]`` (``random()`` takes one 64-bit word per value,
+        so how it is cut into calls changes nothing). Each kind is thus read
+        in an order set by the seed alone, and this policy only decides how
+        many values wait in the buffers: a buffer with fewer than ``batch``
+        unread draws gets a batch. If both still held a batch, one test needed
+        more than that (a long avalanche): both grow, so that the retry gets further.
         """
         sc, ist = self.scene, self.ist
-        rng = self.rngs["tilt"]
         unread = min(self.tmu.size - ist[kernels.TMU_POS], self.tu.size - ist[kernels.TU_POS])
         # Doubling when both held a batch keeps the retries logarithmic in the test's length.
         batch = sc.batch if unread < sc.batch else 2 * max(self.tmu.size, self.tu.size)
-        self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], lambda size: sc.distribution.sample(rng, size), batch)
-        self.tu = _refill(self.tu, ist[kernels.TU_POS], rng.random, batch)
+        self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], self.draws["tilt"].take, batch)
+        self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt_uniforms"].random, batch)
         ist[kernels.TMU_POS] = 0
         ist[kernels.TU_POS] = 0
 

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from slidernet import kernels, solver
+from slidernet import distributions, kernels, solver
 from slidernet.checkpoint import checkpoint_info, load_realization, save_realization
 from slidernet.config import load_config
 from slidernet.errors import CheckpointError
@@ -56,6 +56,9 @@ pytestmark = pytest.mark.filterwarnings("ignore:The event catalogue reached solv
 def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     # Catalogue chunks of 64 rows: several are handed to Python before the checkpoint.
     monkeypatch.setattr(solver, "EVENT_CHUNK", 64)
+    # Raw threshold chunks of 64 draws: the streams' Generators have moved past
+    # their first chunk, and hold a surplus, at the checkpoint.
+    monkeypatch.setattr(distributions, "RAW_CHUNK", 64)
 
 
 def fresh_scene(name: str) -> Scene:
@@ -221,12 +224,25 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     np.savez(tmp_path / "partial.npz", **arrays)
     with pytest.raises(CheckpointError, match=r"inconsistent: it has no array 'state/mu_buf'"):
         load_realization(scene, ss, tmp_path / "partial.npz")
+    # The surplus of a threshold stream is state: missing, or below mu_d, it is refused.
+    arrays = npz_arrays(tmp_path / "r.npz")
+    del arrays["surplus/thresholds"]
+    np.savez(tmp_path / "no_surplus.npz", **arrays)
+    with pytest.raises(CheckpointError, match=r"inconsistent: its threshold streams are \['tilt'\], "
+                                              r"a realization's are \['thresholds', 'tilt'\]"):
+        load_realization(scene, ss, tmp_path / "no_surplus.npz")
+    arrays = npz_arrays(tmp_path / "r.npz")
+    arrays["surplus/tilt"] = np.array([0.6, 0.4])
+    np.savez(tmp_path / "bad_surplus.npz", **arrays)
+    with pytest.raises(CheckpointError, match=r"inconsistent: the surplus of a threshold stream holds values "
+                                              r"that are not finite and > mu_d = 0\.5"):
+        load_realization(scene, ss, tmp_path / "bad_surplus.npz")
     # A layout this version does not read.
     arrays = npz_arrays(tmp_path / "r.npz")
     header = json.loads(arrays["header"].tobytes())
     arrays["header"] = np.frombuffer(json.dumps({**header, "version": 99}).encode(), np.uint8)
     np.savez(tmp_path / "future.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 1"):
+    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 2"):
         load_realization(scene, ss, tmp_path / "future.npz")
     with pytest.raises(FileNotFoundError):
         load_realization(scene, ss, tmp_path / "missing.npz")

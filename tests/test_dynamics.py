@@ -104,7 +104,7 @@ def test_draws_are_the_solvers() -> None:
     assert np.array_equal(thetas, real.thetas)
     assert np.array_equal(stream.initial, real.mu)
     # The solver's next batch comes from the same stream, after mu_buf (its _refill).
-    second = sc.distribution.sample(real.rngs["thresholds"], sc.batch)
+    second = real.draws["thresholds"].take(sc.batch)
     assert np.array_equal([stream.next() for _ in range(2 * sc.batch)], np.concatenate([real.mu_buf, second]))
 
 

@@ -510,44 +510,61 @@ def test_counts_past_2_31_survive_into_the_dataset_and_netcdf(network, tmp_path)
 
 
 class CountedDraws:
-    """The scene's p(mu_s), counting the draws handed to the solver and the records among them.
+    """The scene's p(mu_s), counting the accepted draws its threshold stream hands on and the records.
 
     ``records`` counts the draws above the running maximum of all draws before
-    them (the initial thresholds set it and are no records). The solver asks
-    for a batch only when the previous one is used up, so every batch but the
-    last is scanned whole; the last is kept, since only its first ``MU_POS``
-    draws are used.
+    them (the first ``n_initial``, the initial thresholds, set it and are no
+    records). The stream (:class:`~slidernet.distributions.TruncatedStream`)
+    and the kernel's buffer hold at most a batch and a chunk of draws not yet
+    used, so all but the last ``KEEP`` chunks are scanned as they come (a
+    billion draws are never held at once); :meth:`used` scans the rest up to
+    the number actually used.
     """
 
-    def __init__(self, dist: Any) -> None:
+    KEEP = 3
+
+    def __init__(self, dist: Any, n_initial: int) -> None:
         self.dist = dist
-        self.sizes: list[int] = []
+        self.lower = dist.lower
+        self.n_initial = n_initial
+        self.total = 0  # accepted draws handed to the stream
+        self.scanned = 0
         self.top = -math.inf
         self.records = 0
-        self.last = np.empty(0)
+        self.pending: list[np.ndarray] = []
 
-    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
-        draws = self.dist.sample(rng, size)
-        if not self.sizes:
-            self.top = float(draws.max())
-        else:
-            self.top, self.records = self._scan(self.last, self.top, self.records)
-            self.last = draws.copy()
-        self.sizes.append(size)
+    def accepted(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        draws = self.dist.accepted(rng, size)
+        self.total += draws.size
+        self.pending.append(draws.copy())
+        if len(self.pending) > self.KEEP:
+            self.top, self.records, self.scanned = self._scan(self.pending.pop(0), self.top, self.records,
+                                                              self.scanned)
         return draws
 
-    @staticmethod
-    def _scan(draws: np.ndarray, top: float, records: int) -> tuple[float, int]:
-        if draws.size == 0:
-            return top, records
-        running = np.maximum.accumulate(draws)
-        before = np.concatenate([[top], np.maximum(running[:-1], top)])
-        return max(top, float(running[-1])), records + int((draws > before).sum())
+    def _scan(self, draws: np.ndarray, top: float, records: int, scanned: int) -> tuple[float, int, int]:
+        initial = draws[: max(0, self.n_initial - scanned)]
+        rest = draws[initial.size:]
+        if initial.size:
+            top = max(top, float(initial.max()))
+        if rest.size:
+            running = np.maximum.accumulate(rest)
+            before = np.concatenate([[top], np.maximum(running[:-1], top)])
+            top, records = max(top, float(running[-1])), records + int((rest > before).sum())
+        return top, records, scanned + draws.size
 
-    def used(self, pos: int) -> tuple[int, float, int]:
-        """Draws used by the slips, the largest draw so far (initial ones included), the records."""
-        top, records = self._scan(self.last[:pos], self.top, self.records)
-        return sum(self.sizes[1:-1]) + pos, top, records
+    def used(self, unused: int) -> tuple[int, float, int]:
+        """Draws used by the slips, the largest draw so far (initial ones included), the records.
+
+        ``unused``: the draws handed to the stream that no slip has taken yet
+        (the stream's surplus and the unread part of the kernel's buffer).
+        """
+        top, records, scanned = self.top, self.records, self.scanned
+        end = self.total - unused
+        for chunk in self.pending:
+            top, records, scanned = self._scan(chunk[: max(0, end - scanned)], top, records, scanned)
+        assert scanned >= end
+        return end - self.n_initial, top, records
 
 
 @pytest.mark.slow
@@ -561,7 +578,7 @@ def test_1e9_rearrangements_in_one_realization():
                       observables=["n", "mu_max", "x_G", "n_records"],
                       **{"friction.static": {"name": "uniform", "low": 0.55, "high": 0.65}})
     scene = scene_of(cfg)
-    counted = CountedDraws(scene.distribution)
+    counted = CountedDraws(scene.distribution, scene.network.n_nodes)
     scene.distribution = counted
     r = Realization(scene, np.random.SeedSequence(9))
     for q in range(every, steps + 1, every):
@@ -574,7 +591,8 @@ def test_1e9_rearrangements_in_one_realization():
     assert n >= 1_000_000_000
     # Exact bookkeeping: one draw per slip, none lost or taken twice; mu_max is
     # the largest draw so far and n_records the records among the draws.
-    used, top, records = counted.used(int(r.ist[kernels.MU_POS]))
+    unused = r.draws["thresholds"].surplus.size + r.mu_buf.size - int(r.ist[kernels.MU_POS])
+    used, top, records = counted.used(unused)
     assert used == n
     assert res["mu_max"][-1] == top
     assert res["n_records"][-1] == records

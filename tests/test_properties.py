@@ -102,11 +102,10 @@ def slip_by_slip(real: Realization):
     x_G before, x_G after, new avalanche?) in internal units.
     """
     queue = list(real.mu_buf)
-    rng = real.rngs["thresholds"]
     ist, fst = real.ist, real.fst
     while True:
         if not queue:
-            queue = list(real.scene.distribution.sample(rng, real.scene.batch))
+            queue = list(real.draws["thresholds"].take(real.scene.batch))
         real.mu_buf = np.array(queue[:1])
         ist[kernels.MU_POS] = 0
         before = (real.thresholds, fst[kernels.U], fst[kernels.XG], int(ist[kernels.N_EVENTS]))
@@ -213,11 +212,11 @@ def test_mu_eff_does_not_change_the_horizontal_evolution(seed, phys, network):
 @given(seed=seeds, ratio=st.floats(0.5, 30.0), network=networks)
 def test_buffer_refills_do_not_change_the_horizontal_evolution(seed, ratio, network):
     # The kernel returns at clean points when its threshold buffer is empty
-    # (ARCHITECTURE.md invariant 7). Without rejections by the truncation
-    # (mu_s = 0.6 +- 0.01, mu_d = 0.5: 10 sigma) the thresholds stream is the
-    # same draws whatever solver.batch is, so batch = 16 (a refill every 16
-    # slips) must give the bits of the default batch. With heavy truncation the
-    # rejected draws depend on the batch size, and so do the results.
+    # (ARCHITECTURE.md invariant 7), and the thresholds stream is the same
+    # draws whatever solver.batch is, so batch = 16 (a refill every 16 slips)
+    # must give the bits of the default batch. Here without rejections by the
+    # truncation (mu_s = 0.6 +- 0.01, mu_d = 0.5: 10 sigma); every law under
+    # heavy truncation is in tests/test_batch_independence.py.
     phys = {"network.Ntilde": 1e-7, "driver.sigma_theta": ratio * 1e-7}
     cfg = config(phys, network, steps=20)
     small = simulate(scene_of({**cfg, "solver": {"batch": 16}}), np.random.SeedSequence(seed))
