@@ -448,9 +448,17 @@ class Realization:
         """Recompute a = -K u - g theta(0) + f_ext from the displacements (sparse mat-vec).
 
         Incremental updates of ``a`` accumulate rounding; this resets it and
-        rebuilds the heaps. Returns the largest change of a force, in N (the
-        drift that had accumulated).
+        rebuilds the heaps. The pair kernel keeps no force: it forms
+        F = theta - u afresh at every use, so there is nothing to reset and
+        no drift, and this returns 0.0 there.
+
+        Returns
+        -------
+        float
+            The largest change of a force, in N (the drift that had accumulated).
         """
+        if self.scene.kernel == "pair":
+            return 0.0
         g = self.scene.ops["g"]
         fresh = (-(self.scene.K @ self.u.reshape(-1)) - g.reshape(-1) * self.thetas[0]).reshape(g.shape)
         fresh += self._f_ext()
