@@ -248,7 +248,7 @@ class SolverConfig(_Strict):
 
     kernel: Literal["auto", "pair", "csr", "vec"] = "auto"
     max_avalanche: Annotated[int, Field(ge=1)] = 100_000_000
-    batch: Annotated[int, Field(ge=16)] = 1 << 16
+    batch: Annotated[int, Field(ge=1)] = 1 << 16
     recompute_every: Annotated[int, Field(ge=0)] = 10_000_000
     slip: Literal["straight", "exact"] = "straight"
     max_events: Annotated[int, Field(ge=1)] = 10_000_000

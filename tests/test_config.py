@@ -64,7 +64,7 @@ BAD_VALUES = [
     ("steps", 0, r"'steps' field must be >= 1\. Got 0"),
     ("steps", -5, r"'steps' field must be >= 1"),
     ("seed", -1, r"'seed' field must be >= 0"),
-    ("solver.batch", 4, r"'solver\.batch' field must be >= 16"),
+    ("solver.batch", 0, r"'solver\.batch' field must be >= 1"),
     ("solver.kernel", "gpu", r"'solver\.kernel' field: Input should be 'auto', 'pair', 'csr' or 'vec'"),
     ("observables", ["n", "energy"], r"'observables\.1' field: .*'mu_eff'"),
     ("foo", 1, r"Unknown key 'foo'\."),
