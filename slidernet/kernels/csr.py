@@ -9,7 +9,15 @@ these only change when the node or a neighbour slips.
 
 from __future__ import annotations
 
-from slidernet.kernels.heap import avalanche_done, heap_set, log_event, mu_stats, redraw_threshold
+from slidernet.kernels.heap import (
+    avalanche_done,
+    close_t0,
+    heap_set,
+    log_event,
+    mu_stats,
+    open_initial_relaxation,
+    redraw_threshold,
+)
 from slidernet.kernels.state import (
     AV_SLIPS,
     AVALANCHE_LIMIT,
@@ -113,21 +121,8 @@ def run_csr(
     :func:`~slidernet.kernels.heap.log_event`) is on and its buffer is full.
     """
     steps = thetas.size - 1
-    if ist[STARTED] == 0:
-        if ist[HEAP_SIZE] > 0:
-            # A load f_ext above some threshold: relaxed first, as part of t = 0.
-            # No driving slip here: the avalanche's size is its slips alone.
-            ist[IN_AVALANCHE] = 1
-            ist[AV_SLIPS] = -1
-        else:
-            if do_tilt:
-                F = a[1] + g[1] * fst[THETA]
-                st = tilt_sample(F, mu[0], mu[1], mu_d, tmu, tu, ist, ist[REC], fsum, fsq, fcount)
-                if st != DONE:
-                    return st
-            if rec_times[ist[REC]] == 0:
-                _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)
-            ist[STARTED] = 1
+    # A load f_ext above some threshold is relaxed first, as part of t = 0.
+    open_initial_relaxation(ist)
     while True:
         while ist[HEAP_SIZE] > 0:
             i = hp[0, 0]
@@ -155,11 +150,15 @@ def run_csr(
                   ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f)
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
         if ist[STARTED] == 0:
-            # The end of the initial relaxation (the tilt test before each
-            # rearrangement needs f_ext = 0, so it never starts here).
-            if rec_times[ist[REC]] == 0:
+            # The tilt test before each rearrangement needs f_ext = 0, so
+            # there was no initial relaxation: this is the state at t = 0.
+            if do_tilt:
+                st = tilt_sample(a[1] + g[1] * fst[THETA], mu[0], mu[1], mu_d, tmu, tu, ist,
+                                 ist[REC], fsum, fsq, fcount)
+                if st != DONE:
+                    return st
+            if close_t0(ist, rec_times):
                 _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)
-            ist[STARTED] = 1
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
         q = ist[Q]

@@ -15,20 +15,30 @@ The kernels use three heaps: unstable nodes keyed by overload
 (the next event when theta rises); driven nodes keyed by their lower
 critical theta (the next event when theta falls). Negation is exact, so a
 min-heap on theta_up is a max-heap on -theta_up with the same tie rule.
+
+The avalanche bookkeeping of t = 0 is here too, in one place for both
+network kernels (:func:`open_initial_relaxation`, :func:`close_t0`): a
+kernel is re-entered after every buffer refill, and only its first entry
+may open the relaxation of an initial overload.
 """
 
 from __future__ import annotations
 
 from slidernet.kernels.state import (
     ARGMAX,
+    AV_SLIPS,
     EV_POS,
     EV_T,
+    HEAP_SIZE,
+    IN_AVALANCHE,
     MU_MAX,
     MU_POS,
     N_EVENTS,
     N_RECORDS,
     N_SLIPS,
+    REC,
     SINCE_RECOMPUTE,
+    STARTED,
     kernel_jit,
 )
 
@@ -115,15 +125,52 @@ def heap_set(node, value, present, hp, hv, hpos, w, ist, slot):
 
 @kernel_jit()
 def avalanche_done(ist, aval_hist, av_slot, flag_slot):
-    """Close the current avalanche: bin its size (slips) by floor(log2 size)."""
+    """Close the current avalanche: bin its size (slips) by floor(log2 size).
+
+    ``ist[av_slot]`` counts the slips after the driving slip, so the size is
+    one more; the relaxation at t = 0 has no driving slip and starts the
+    count at -1 (:func:`open_initial_relaxation`).
+    """
     if ist[flag_slot]:
-        size = ist[av_slot] + 1  # the driving slip plus the avalanche slips
+        size = ist[av_slot] + 1
         b = 0
         while size > 1:
             size >>= 1
             b += 1
         aval_hist[b] += 1
         ist[flag_slot] = 0
+
+
+@kernel_jit(inline="always")
+def open_initial_relaxation(ist):
+    """Open avalanche 0, the relaxation of an overload at t = 0 (a large f_ext), once.
+
+    Call it on every entry of a network kernel: only the first entry of a
+    run whose unstable heap is non-empty opens it. Later entries before t =
+    0 is closed (after a buffer refill in the middle of the relaxation) find
+    it open and must not restart its count. It has no driving slip, so its
+    count starts at -1: its size (``AV_SLIPS`` + 1, see
+    :func:`avalanche_done`) is then its slips alone.
+    """
+    if ist[STARTED] == 0 and ist[IN_AVALANCHE] == 0 and ist[HEAP_SIZE] > 0:
+        ist[IN_AVALANCHE] = 1
+        ist[AV_SLIPS] = -1
+
+
+@kernel_jit(inline="always")
+def close_t0(ist, rec_times):
+    """Close t = 0 once the network is stable; True if the t = 0 record is due now.
+
+    Call it where the unstable heap is empty and the avalanche closed, before
+    the first driving event. It returns True at most once per run: the caller
+    then writes the record (anything sampled at t = 0, such as the tilt
+    test, must come before the call, since a kernel that returned for more
+    draws before it would find t = 0 closed on re-entry).
+    """
+    if ist[STARTED] != 0:
+        return False
+    ist[STARTED] = 1
+    return rec_times[ist[REC]] == 0
 
 
 @kernel_jit(inline="always")

@@ -22,7 +22,15 @@ from __future__ import annotations
 
 import math
 
-from slidernet.kernels.heap import avalanche_done, heap_set, log_event, mu_stats, redraw_threshold
+from slidernet.kernels.heap import (
+    avalanche_done,
+    close_t0,
+    heap_set,
+    log_event,
+    mu_stats,
+    open_initial_relaxation,
+    redraw_threshold,
+)
 from slidernet.kernels.state import (
     AV_SLIPS,
     AVALANCHE_LIMIT,
@@ -44,7 +52,6 @@ from slidernet.kernels.state import (
     REC,
     RECOMPUTE,
     SINCE_RECOMPUTE,
-    STARTED,
     THETA,
     UP_SIZE,
     XG,
@@ -314,13 +321,7 @@ def run_vec(
     state (a large f_ext) is relaxed first.
     """
     steps = thetas.size - 1
-    if ist[STARTED] == 0:
-        if ist[HEAP_SIZE] == 0 and rec_times[ist[REC]] == 0:
-            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean,
-                    out_mu_min)
-            ist[STARTED] = 1
-        elif ist[HEAP_SIZE] > 0:
-            ist[IN_AVALANCHE] = 1
+    open_initial_relaxation(ist)
     while True:
         while ist[HEAP_SIZE] > 0:
             i = hp[0, 0]
@@ -343,12 +344,10 @@ def run_vec(
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
         avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
-        if ist[STARTED] == 0:
-            # The initial relaxation (f_ext above a threshold) belongs to t = 0.
-            if rec_times[ist[REC]] == 0:
-                _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records,
-                        out_mu_mean, out_mu_min)
-            ist[STARTED] = 1
+        # The t = 0 record is of the state after the initial relaxation.
+        if close_t0(ist, rec_times):
+            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records,
+                    out_mu_mean, out_mu_min)
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
         q = ist[Q]
