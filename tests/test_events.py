@@ -7,7 +7,9 @@ import pytest
 
 import slidernet
 from slidernet import solver
+from slidernet.builders import triangular
 from slidernet.config import load_config
+from slidernet.network import Network, chain
 from slidernet.solver import Realization, Scene
 
 from .conftest import make_config
@@ -25,6 +27,13 @@ def events_config(net: dict, steps: int = 40, events: bool = True, **changes) ->
                           "network": {**net, "Ntilde": 1e-7}, "driver.sigma_theta": 3e-7, **changes})
 
 
+def catalogued_displacements(ev: dict, shape: tuple[int, ...]) -> np.ndarray:
+    """Per-node sums of the catalogue's slips, shape (N, d) like ``Realization.displacements()``."""
+    u = np.zeros((shape[0], 2))
+    np.add.at(u, ev["node"], np.column_stack([ev["dx"], ev["dy"]]))
+    return u[:, : shape[1]]
+
+
 @pytest.fixture
 def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     # Many returns of the kernel to Python per run: exercises the buffer hand-over.
@@ -37,11 +46,11 @@ def test_the_catalogue_adds_up_to_the_records(net, small_chunks):
     r = Realization(Scene.from_config(cfg), np.random.SeedSequence(5)).advance()
     res, ev = r.result(), r.events()
     assert ev["node"].size == res["n"][-1] > 64 * 3
-    # Each slip counted once per node, and the centre of mass moves by the
-    # load-weighted sum of the slips.
+    # Each slip counted once per node, and the slips of a node add up to its
+    # displacement in the final state (the u that the forces are recomputed from).
     np.testing.assert_array_equal(np.bincount(ev["node"], minlength=r.mu.size), res["node_slips"])
-    w = r.scene.network.normal_load / r.scene.network.normal_load.sum()
-    assert (w[ev["node"]] * ev["dx"]).sum() == pytest.approx(res["x_G"][-1], rel=1e-9, abs=1e-18)
+    u = r.displacements()
+    np.testing.assert_allclose(catalogued_displacements(ev, u.shape), u, rtol=1e-12, atol=1e-18)
     # Time runs forward; avalanche ids count the driving events.
     assert (np.diff(ev["time"]) >= 0).all() and ev["time"][0] >= 0 and ev["time"][-1] <= cfg.steps
     assert (np.diff(ev["avalanche"]) >= 0).all()
@@ -90,3 +99,37 @@ def test_the_catalogue_is_written_to_netcdf(tmp_path):
     for name in ("event_time", "event_node", "event_avalanche", "event_dx", "event_dy", "event_realization"):
         np.testing.assert_array_equal(back[name].values, ds[name].values, err_msg=name)
     assert back["event_dx"].attrs["units"] == "l0"
+
+
+# --- x_G -------------------------------------------------------------------
+
+
+def loaded(net: dict) -> Network:
+    """The network of ``net`` with unequal normal loads (1 to 2.5 N), so that x_G is not the plain mean of u."""
+    if net["kind"] == "triangular":
+        return triangular(net["shape"], Ntilde=1e-7, normal_load=np.linspace(1.0, 2.5, np.prod(net["shape"])))
+    n = net.get("n", 2)
+    return chain(n, Ntilde=1e-7, normal_load=np.linspace(1.0, 2.5, n))
+
+
+@pytest.mark.parametrize("net", list(NETWORKS.values()), ids=list(NETWORKS))
+def test_x_G_is_the_load_weighted_mean_of_the_catalogued_displacements(net, small_chunks):
+    # The kernel adds the same du to the catalogue, to u and to x_G. x_G must
+    # be the load-weighted mean of the displacements at every recorded time:
+    # rebuilt here from the catalogue's slips up to t and the network's loads,
+    # and at the end from the displacements of the final state.
+    network = loaded(net)
+    scene = Scene.from_config(load_config(events_config(net)), network)
+    r = Realization(scene, np.random.SeedSequence(5)).advance()
+    res, ev = r.result(), r.events()
+    weight = network.normal_load / network.normal_load.sum()
+    upto = np.searchsorted(ev["time"], scene.rec_times, side="right")
+    x_G = np.concatenate([[0.0], np.cumsum(weight[ev["node"]] * ev["dx"])])[upto]
+    np.testing.assert_allclose(res["x_G"], x_G, rtol=1e-9, atol=1e-18)
+    u = r.displacements()
+    assert res["x_G"][-1] == pytest.approx(weight @ u[:, 0], rel=1e-9, abs=1e-18)
+    if u.shape[1] == 2:
+        assert res["y_G"][-1] == pytest.approx(weight @ u[:, 1], rel=1e-9, abs=1e-18)
+    # The loads matter here: the plain mean of the displacements is another number.
+    assert abs(u[:, 0].mean() - res["x_G"][-1]) > 1e-3 * abs(res["x_G"][-1]) > 0
+
