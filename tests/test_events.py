@@ -133,3 +133,83 @@ def test_x_G_is_the_load_weighted_mean_of_the_catalogued_displacements(net, smal
     # The loads matter here: the plain mean of the displacements is another number.
     assert abs(u[:, 0].mean() - res["x_G"][-1]) > 1e-3 * abs(res["x_G"][-1]) > 0
 
+
+# --- avalanche_count ------------------------------------------------------
+
+
+def catalogue_avalanche_count(ev: dict, bins: int) -> np.ndarray:
+    """``avalanche_count`` rebuilt from the catalogue: slips per avalanche id, binned by floor(log2 size).
+
+    Id 0 is the relaxation at t = 0 (its slips alone), id k > 0 the k-th
+    driving event (its driving slip and the slips it set off).
+    """
+    _, sizes = np.unique(ev["avalanche"], return_counts=True)
+    _, exponent = np.frexp(sizes)  # size = m 2**e with 0.5 <= m < 1: floor(log2 size) = e - 1, exactly
+    return np.bincount(exponent - 1, minlength=bins)
+
+
+# A chain for the csr kernel, a triangular lattice for the vec kernel.
+KERNEL_NETWORKS = {
+    "csr": {"kind": "chain", "n": 20},
+    "vec": {"kind": "triangular", "shape": [6, 6]},
+}
+DEFAULT_BATCH = 1 << 16  # solver.batch's default
+
+
+def with_f_ext(net: dict, fx: np.ndarray) -> Network:
+    """The network of ``net`` (a chain or a triangular lattice) with the force ``fx[i]`` along x on node i."""
+    if net["kind"] == "chain":
+        return chain(net["n"], Ntilde=1e-7, f_ext=fx)
+    return triangular(net["shape"], Ntilde=1e-7, f_ext=np.column_stack([fx, np.zeros_like(fx)]))
+
+
+def halves_pushed_together(net: dict) -> Network:
+    """0.7 N along +x on the left half of the chain or of each row of the lattice, along -x on the right half.
+
+    0.7 N is above every threshold (0.6 +- 0.01): every slider is overloaded
+    at t = 0, and the relaxation takes tens to hundreds of slips. The forces
+    cancel: a uniform f_ext above mu_d would make the network slide for ever.
+    """
+    n, cols = (net["n"], net["n"]) if net["kind"] == "chain" else (np.prod(net["shape"]), net["shape"][1])
+    return with_f_ext(net, np.where(np.arange(n) % cols < cols // 2, 0.7, -0.7))
+
+
+@pytest.mark.parametrize("batch", [16, DEFAULT_BATCH], ids=["batch16", "default_batch"])
+@pytest.mark.parametrize("overload", [True, False], ids=["overload_at_t0", "driven_only"])
+@pytest.mark.parametrize("kernel", list(KERNEL_NETWORKS))
+def test_avalanche_count_is_the_catalogue_binned(kernel, overload, batch):
+    net = KERNEL_NETWORKS[kernel]
+    cfg = load_config(events_config(net, **{"solver.batch": batch}))
+    scene = Scene.from_config(cfg, halves_pushed_together(net) if overload else None)
+    assert scene.kernel == kernel
+    r = Realization(scene, np.random.SeedSequence(5)).advance()
+    res, ev = r.result(), r.events()
+    relaxation = int((ev["avalanche"] == 0).sum())
+    if overload:
+        # The kernel returns for thresholds every `batch` slips: at batch 16 the
+        # relaxation spans several refills, each a re-entry before t = 0.
+        assert relaxation > 3 * 16
+        assert res["n"][0] == relaxation
+    else:
+        assert relaxation == 0
+    assert res["n_events"] > 100
+    expected = catalogue_avalanche_count(ev, res["avalanche_count"].size)
+    np.testing.assert_array_equal(res["avalanche_count"], expected)
+    assert res["avalanche_count"].sum() == res["n_events"] + (relaxation > 0)
+
+
+@pytest.mark.parametrize("kernel", list(KERNEL_NETWORKS))
+def test_one_overloaded_slider_is_an_avalanche_of_one_slip(kernel):
+    # 0.7 N on one interior slider: it slips once, to 2 mu_d - 0.7 = 0.3 N, and
+    # its neighbours take less than their thresholds. There is no driving
+    # slip, so the relaxation's size is 1: bin 0.
+    net = KERNEL_NETWORKS[kernel]
+    n = net.get("n") or int(np.prod(net["shape"]))
+    node = n // 2 + 3
+    scene = Scene.from_config(load_config(events_config(net)), with_f_ext(net, 0.7 * (np.arange(n) == node)))
+    r = Realization(scene, np.random.SeedSequence(5))
+    r.advance(0)
+    res = r.result()
+    assert r.n == 1 and res["n_events"] == 0
+    assert r.events()["node"].tolist() == [node]
+    assert res["avalanche_count"].tolist() == [1] + [0] * (res["avalanche_count"].size - 1)
