@@ -6,7 +6,7 @@ inlining the heap and slip helpers made the 2D kernel 35-50 % faster
 (A/B in one process, 1e3 and 1e6 nodes).
 
 A heap holds node indices ordered by a per-node key (largest first, ties
-to the lowest node index, which is the documented tie rule of MODEL.md).
+to the lowest node index: the tie rule of ARCHITECTURE.md, item 4).
 ``hpos[node, w]`` is the node's slot in heap w or -1, so that re-keying or
 removing a node costs O(log size). Its size lives in ``ist[slot]``.
 

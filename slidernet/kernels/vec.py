@@ -3,8 +3,8 @@
 The force on node i is the 2-vector F_i = a_i + g_i theta (a = -K u - g
 theta(0) + f_ext), and node i sticks while |F_i| <= mu_s,i N_i. Along a
 linear segment of theta, |F_i(theta)|^2 = (mu_s,i N_i)^2 is a quadratic in
-theta (MODEL.md section 2) whose roots theta_dn,i <= theta <= theta_up,i
-bound the node's stable range: they key the driving heaps.
+theta whose roots theta_dn,i <= theta <= theta_up,i bound the node's
+stable range: they key the driving heaps.
 
 A slip moves node i alone, the others fixed, as an undamped half-oscillation
 under Coulomb friction with the local stiffness K_ii (a 2x2 block):
