@@ -30,6 +30,7 @@ import json
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 import uuid
@@ -121,6 +122,9 @@ class StopSignal:
         if self.signum is not None:
             raise KeyboardInterrupt
         self.request(signum)
+        # Said at once: saving can take a moment, and the user should know a second Ctrl-C is heard.
+        print(f"slidernet: {signal.Signals(signum).name} received: the running realizations stop at their next "
+              "clean point and are saved; send it again to stop at once.", file=sys.stderr, flush=True)
 
     def __enter__(self) -> StopSignal:
         global _PROCESS_STOP
@@ -279,13 +283,16 @@ def _init_worker(flag: Any) -> None:
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
-    """Kill the pool's workers now (a second Ctrl-C): their last saves are complete files."""
-    kill = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    """Kill the pool's workers now (a second Ctrl-C): their last saves are complete files.
+
+    SIGKILL, since the workers ignore SIGTERM (see :func:`_init_worker`).
+    """
+    kill = getattr(pool, "kill_workers", None)  # Python >= 3.14
     if kill is not None:
         kill()
         return
     for proc in list((getattr(pool, "_processes", None) or {}).values()):
-        proc.terminate()
+        proc.kill()
 
 
 def _local_pool(indices: Sequence[int], args: Task, workers: int,
@@ -331,13 +338,20 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
         # Ctrl-C) running realizations are told to stop and save.
         flag.set()
         try:
+            # Short waits, not one long join: a signal that the OS hands to
+            # another thread reaches Python's handler only when the main
+            # thread wakes up.
+            while running and not forced:
+                _, pending = wait(running, timeout=_POLL)
+                if not pending:
+                    break
+        except KeyboardInterrupt:  # a second Ctrl-C while the workers save
+            forced = True
+            raise
+        finally:
             if forced:
                 _terminate(pool)
-            pool.shutdown(wait=True, cancel_futures=True)
-        except KeyboardInterrupt:  # a second Ctrl-C while the workers save
-            _terminate(pool)
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
+            pool.shutdown(wait=not forced, cancel_futures=True)
 
 
 def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
@@ -386,12 +400,17 @@ def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
                     if not stop.requested:
                         submit_next()
         finally:
-            if running:
-                event.set()
-                try:
-                    dask_wait(list(running), timeout=60)
-                except (TimeoutError, KeyboardInterrupt):
-                    pass
+            # Running tasks save and return; short waits keep the main thread awake for a second signal.
+            event.set()
+            try:
+                while running:
+                    try:
+                        dask_wait(list(running), timeout=_POLL)
+                        break
+                    except TimeoutError:
+                        continue
+            except KeyboardInterrupt:
+                pass
 
 
 def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str | None = None,

@@ -4,8 +4,9 @@
 truncated). When the environment names a gate folder
 (``SLIDERNET_TEST_GATE``), a process that has drawn more than
 ``SLIDERNET_TEST_GATE_AFTER`` thresholds stops in ``sample``: it creates
-``waiting-<pid>`` in the folder and waits until the file ``open`` exists
-there (once per process). A test thereby holds a run at a known point, with
+``waiting-<pid>-<thread>`` in the folder and waits until the file ``open``
+exists there (once per process and thread: a Dask worker runs realizations
+in threads). A test thereby holds a run at a known point, with
 every running realization part-way through and checkpointed, while it sends
 a signal or kills the run: it never races the machine's speed. Without the
 variable the law is a plain uniform, so a run's bits do not depend on the
@@ -19,8 +20,10 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -31,8 +34,8 @@ from slidernet.cli import main
 class Gated:
     """Uniform p(mu_s) on [low, high] with a gate in ``sample`` (see the module docstring)."""
 
-    drawn = 0
-    passed = False
+    drawn: ClassVar[dict[tuple[int, int], int]] = {}
+    passed: ClassVar[set[tuple[int, int]]] = set()
 
     def __init__(self, low: float = 0.55, high: float = 0.65) -> None:
         self.low = float(low)
@@ -40,20 +43,20 @@ class Gated:
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         gate = os.environ.get("SLIDERNET_TEST_GATE")
-        if gate and not Gated.passed:
-            Gated.drawn += size
-            if Gated.drawn > int(os.environ["SLIDERNET_TEST_GATE_AFTER"]):
-                Path(gate, f"waiting-{os.getpid()}").touch()
+        who = (os.getpid(), threading.get_ident())
+        if gate and who not in Gated.passed:
+            Gated.drawn[who] = Gated.drawn.get(who, 0) + size
+            if Gated.drawn[who] > int(os.environ["SLIDERNET_TEST_GATE_AFTER"]):
+                Path(gate, f"waiting-{who[0]}-{who[1]}").touch()
                 while not Path(gate, "open").exists():
                     time.sleep(0.01)
-                Gated.passed = True
+                Gated.passed.add(who)
         return rng.uniform(self.low, self.high, size)
 
     def cdf(self, x: np.ndarray | float) -> np.ndarray:
         return np.clip((np.asarray(x, dtype=float) - self.low) / (self.high - self.low), 0.0, 1.0)
 
 
-slidernet.register_distribution("gated", Gated)
-
 if __name__ == "__main__":
+    slidernet.register_distribution("gated", Gated)
     sys.exit(main(sys.argv[1:]))

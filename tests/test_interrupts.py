@@ -1,0 +1,230 @@
+"""Interrupts: Ctrl-C, SIGTERM and kill -9 in the middle of realizations, with one and two workers.
+
+Every test holds the run at a gate (``tests/gated_cli.py``): each running
+realization is part-way through and has saved a checkpoint when the test
+acts, whatever the speed of the machine. The contract:
+
+- SIGINT and SIGTERM stop the running realizations at their next clean
+  point and save them; no queued realization starts; the exit status is
+  130 or 143 and the message gives the resume command;
+- a second Ctrl-C stops at once and still leaves a consistent folder;
+- after any of these (and after kill -9) ``--resume`` gives the bits of an
+  uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from slidernet.io import read_result
+
+GATED_CLI = Path(__file__).with_name("gated_cli.py")
+
+# Realizations of about 1e5 slips each (an 8 x 8 triangular lattice), the
+# event catalogue and the network tilt test on; checkpoints at every chunk;
+# threshold draws in small batches, so that the gate falls a few steps in.
+LONG = """\
+seed = 3
+realizations = 4
+steps = 60
+observables = ["n", "mu_max", "x_G", "mu_eff", "events"]
+[network]
+kind = "triangular"
+shape = [8, 8]
+Ntilde = 1e-7
+[friction]
+mu_d = 0.5
+[friction.static]
+name = "gated"
+[driver]
+name = "gaussian_steps"
+sigma_theta = 2e-7
+[solver]
+batch = 256
+[execution]
+checkpoint_every = 1e-9
+"""
+GATE_AFTER = 2 * 65_536  # thresholds drawn by a process before it waits: its third raw chunk, steps in
+
+
+def _cli(*args: str, gate: Path | None = None) -> subprocess.Popen:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("SLIDERNET_TEST_GATE")}
+    if gate is not None:
+        gate.mkdir(exist_ok=True)
+        env.update(SLIDERNET_TEST_GATE=str(gate), SLIDERNET_TEST_GATE_AFTER=str(GATE_AFTER))
+    return subprocess.Popen([sys.executable, str(GATED_CLI), *args, "--no-progress"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+
+def _finish(proc: subprocess.Popen) -> tuple[int, str]:
+    try:
+        _, err = proc.communicate(timeout=300)  # a hang guard, not a speed requirement
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        raise
+    return proc.returncode, err
+
+
+def _wait_at_gate(gate: Path, proc: subprocess.Popen, processes: int) -> None:
+    """Wait (on files) until ``processes`` processes of the run stand at the gate."""
+    while len(list(gate.glob("waiting-*"))) < processes:
+        if proc.poll() is not None:
+            pytest.fail(f"the run ended before reaching the gate: {proc.communicate()}")
+        time.sleep(0.02)
+
+
+def _assert_same_bits(a_path: Path, b_path: Path) -> None:
+    a, b = read_result(a_path), read_result(b_path)
+    assert set(a.variables) == set(b.variables)
+    for name in a.variables:
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+    assert json.loads(a.attrs["config"]) == json.loads(b.attrs["config"])
+
+
+def _assert_consistent(checkpoint: Path) -> None:
+    """Only complete files: every npz opens without pickle, no temporary file is left."""
+    assert not [p.name for p in checkpoint.iterdir() if p.name.endswith(".tmp")]
+    for f in checkpoint.glob("*.npz"):
+        with np.load(f, allow_pickle=False) as z:
+            [z[k] for k in z.files]
+
+
+@pytest.fixture(scope="module")
+def config(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("interrupts") / "long.toml"
+    path.write_text(LONG)
+    return path
+
+
+@pytest.fixture(scope="module")
+def reference(config) -> Path:
+    """The uninterrupted run (one worker, no gate)."""
+    out = config.parent / "reference"
+    rc, err = _finish(_cli("run", str(config), "--out", str(out), "--workers", "1"))
+    assert rc == 0, err
+    return out / "result.nc"
+
+
+def _resume(config: Path, out: Path, workers: str = "2") -> None:
+    rc, err = _finish(_cli("run", str(config), "--out", str(out), "--resume", "--workers", workers))
+    assert rc == 0, err
+    assert not (out / "checkpoint").exists()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("sig", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("workers", [1, 2], ids=["one-worker", "two-workers"])
+def test_a_signal_saves_the_running_realizations_and_starts_no_other(tmp_path, config, reference, sig, status,
+                                                                      workers):
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", str(workers), gate=gate)
+    _wait_at_gate(gate, proc, workers)
+    if sig == signal.SIGINT:
+        os.killpg(proc.pid, sig)  # Ctrl-C reaches every process of the terminal's group
+    else:
+        os.kill(proc.pid, sig)  # a batch scheduler's SIGTERM, to the main process
+    (gate / "open").touch()
+    rc, err = _finish(proc)
+    assert rc == status, err
+    assert f"interrupted by {sig.name}" in err and "--resume" in err
+    assert f"0 of 4 realizations are finished and {workers} saved in progress" in err
+    assert not (out / "result.nc").exists()
+    checkpoint = out / "checkpoint"
+    _assert_consistent(checkpoint)
+    # The running realizations (the first ones handed out) are saved; the queued ones never started.
+    assert sorted(p.name for p in checkpoint.glob("partial-*.npz")) == [
+        f"partial-{r:09d}.npz" for r in range(workers)]
+    for r in range(workers):
+        with np.load(checkpoint / f"partial-{r:09d}.npz", allow_pickle=False) as z:
+            assert json.loads(bytes(z["header"]).decode())["step"] > 0
+    # Without --resume the interrupted run is refused, not overwritten.
+    rc, err = _finish(_cli("run", str(config), "--out", str(out)))
+    assert rc == 2 and "--resume" in err
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+
+
+@pytest.mark.slow
+def test_a_second_ctrl_c_stops_at_once_and_leaves_a_consistent_folder(tmp_path, config, reference):
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", "2", gate=gate)
+    _wait_at_gate(gate, proc, 2)
+    os.killpg(proc.pid, signal.SIGINT)
+    # Two signals sent at once would merge into one: wait until the first is taken, which slidernet says.
+    first = proc.stderr.readline()
+    assert "SIGINT received" in first and "again to stop at once" in first
+    os.killpg(proc.pid, signal.SIGINT)  # the workers still stand at the gate: only the second signal ends them
+    rc, err = _finish(proc)
+    assert rc == 130, first + err
+    _assert_consistent(out / "checkpoint")
+    assert (out / "checkpoint" / "run.json").exists()
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("workers", [1, 2], ids=["one-worker", "two-workers"])
+def test_resume_after_kill_9_gives_the_same_bits(tmp_path, config, reference, workers):
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", str(workers), gate=gate)
+    _wait_at_gate(gate, proc, workers)
+    assert len(list((out / "checkpoint").glob("partial-*.npz"))) == workers
+    os.killpg(proc.pid, signal.SIGKILL)  # the whole session, as in a machine failure
+    proc.wait()
+    assert not (out / "result.nc").exists()
+    _assert_consistent(out / "checkpoint")
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_run_on_a_dask_cluster(tmp_path, config, reference, monkeypatch):
+    """The workers are threads of a Dask cluster: they learn of the stop through a Dask Event."""
+    import importlib.util
+    import threading
+
+    distributed = pytest.importorskip("distributed")
+    import slidernet
+    from slidernet import registry
+    from slidernet.config import tomllib
+    from slidernet.errors import RunInterrupted
+
+    spec = importlib.util.spec_from_file_location("gated_cli", GATED_CLI)
+    gated = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gated)
+    monkeypatch.setitem(registry.distributions._runtime, "gated", gated.Gated)
+    gate, out = tmp_path / "gate", tmp_path / "out"
+    gate.mkdir()
+    monkeypatch.setenv("SLIDERNET_TEST_GATE", str(gate))
+    monkeypatch.setenv("SLIDERNET_TEST_GATE_AFTER", str(GATE_AFTER))
+    cfg = tomllib.loads(LONG)
+
+    def press_ctrl_c_at_the_gate() -> None:
+        while len(list(gate.glob("waiting-*"))) < 2:
+            time.sleep(0.02)
+        os.kill(os.getpid(), signal.SIGINT)  # the run's handler takes it in the main thread
+        (gate / "open").touch()
+
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        presser = threading.Thread(target=press_ctrl_c_at_the_gate, daemon=True)
+        presser.start()
+        with pytest.raises(RunInterrupted, match="0 of 4 realizations are finished and 2 saved in progress"):
+            slidernet.run(cfg, out=out, scheduler=cluster.scheduler_address)
+        presser.join()
+    _assert_consistent(out / "checkpoint")
+    assert sorted(p.name for p in (out / "checkpoint").glob("partial-*.npz")) == [
+        f"partial-{r:09d}.npz" for r in range(2)]
+    monkeypatch.delenv("SLIDERNET_TEST_GATE")
+    slidernet.run(cfg, out=out, resume=True, workers=1).close()
+    _assert_same_bits(out / "result.nc", reference)
