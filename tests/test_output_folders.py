@@ -166,3 +166,17 @@ def test_progress_only_on_a_terminal(tmp_path, config):
         assert proc.returncode == 0, proc.stderr
         assert "realizations" not in proc.stderr and "it/s" not in proc.stderr
         assert json.loads(slidernet.io.read_result(out / "result.nc").attrs["config"])["seed"] == 1
+
+
+def test_cli_messages_use_the_cli_spelling(tmp_path, config, capsys):
+    """An interrupted run refused without --resume: the message names the flag, not the Python keyword."""
+    out = tmp_path / "out"
+
+    def interrupt(r: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        slidernet.run(config, out=out, workers=1, on_realization=interrupt)
+    line = _one_line_error(capsys, main(["run", str(config), "--out", str(out), "--no-progress"]))
+    assert "holds an interrupted run" in line and "--resume" in line and "--overwrite" in line
+    assert "resume=True" not in line
