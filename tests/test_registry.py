@@ -133,7 +133,11 @@ def test_distribution_of_wrong_shape_is_named(clean_registries):
             return np.float64(0.6)
 
     slidernet.register_distribution("scalar", Scalar)
-    with pytest.raises(PluginError, match=r"'scalar' returned shape \(\) from sample\(rng, 2\); expected \(2,\)"):
+    # The solver asks a plugin for fixed raw chunks of RAW_CHUNK draws (batch-independent streams).
+    from slidernet.distributions import RAW_CHUNK
+
+    with pytest.raises(PluginError, match=rf"'scalar' returned shape \(\) from sample\(rng, {RAW_CHUNK}\); "
+                                          rf"expected \({RAW_CHUNK},\)"):
         slidernet.run(make_config(**SMALL, **{"friction.static": {"name": "scalar"}}))
 
 
