@@ -1,0 +1,80 @@
+"""How long Ctrl-C (SIGINT) and SIGTERM take to stop a run with long realizations, and what they save.
+
+Starts ``slidernet run`` with 2 workers on realizations of about a minute or
+more each (an 8 x 8 triangular lattice, 3e6 thermal steps), sends the signal
+after ``--after`` seconds, and reports the exit status, the seconds from the
+signal to the exit, and the realizations saved in progress (with the step
+each reached). Resuming such a run to the bits of an uninterrupted one is
+tested in tests/test_interrupts.py.
+
+    python benchmarks/interrupt_latency.py [--after 15] [--workers 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+CONFIG = """\
+seed = 1
+realizations = 6
+steps = 3000000
+observables = ["n", "mu_max", "x_G"]
+[network]
+kind = "triangular"
+shape = [8, 8]
+Ntilde = 1e-7
+[friction]
+mu_d = 0.5
+[friction.static]
+name = "gaussian"
+mean = 0.6
+std = 0.01
+[driver]
+name = "gaussian_steps"
+sigma_theta = 2e-7
+[execution]
+checkpoint_every = 60.0
+"""
+
+
+def measure(sig: signal.Signals, after: float, workers: int, folder: Path) -> dict:
+    config = folder / "long.toml"
+    config.write_text(CONFIG)
+    out = folder / f"out-{sig.name}"
+    proc = subprocess.Popen([sys.executable, "-m", "slidernet.cli", "run", str(config), "--out", str(out),
+                             "--workers", str(workers), "--no-progress"], stderr=subprocess.PIPE, text=True)
+    time.sleep(after)
+    sent = time.monotonic()
+    proc.send_signal(sig)
+    _, err = proc.communicate()
+    took = time.monotonic() - sent
+    steps = []
+    for f in sorted((out / "checkpoint").glob("partial-*.npz")):
+        with np.load(f, allow_pickle=False) as z:
+            steps.append(json.loads(bytes(z["header"]).decode())["step"])
+    return {"signal": sig.name, "exit_status": proc.returncode, "seconds_to_exit": round(took, 2),
+            "saved_in_progress": len(steps), "steps_reached": steps, "message": err.strip().splitlines()[-1]}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--after", type=float, default=15.0, help="seconds before the signal")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            print(json.dumps(measure(sig, args.after, args.workers, Path(tmp))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
