@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import slidernet
-from slidernet.execution import available_cores
+from slidernet.ensemble.execution import available_cores
 
 PAIR = {
     "seed": 1,

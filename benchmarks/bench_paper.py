@@ -1,4 +1,4 @@
-"""Wall time and peak memory of reproducing the paper's figures (``slidernet.paper.reproduce``).
+"""Wall time and peak memory of reproducing the paper's figures (``slidernet.paper.reproduction.reproduce``).
 
     python benchmarks/bench_paper.py [--full] [--out DIR] [--csv PATH]
 
@@ -11,7 +11,7 @@ fill it), and loading them counts in the reproduction's time.
 
 For each preset it prints and writes to ``--csv`` (one row per preset):
 
-- ``import_s``: importing ``slidernet.paper`` in the fresh process;
+- ``import_s``: importing ``slidernet.paper.reproduction`` in the fresh process;
 - ``reproduce_s``: the ``reproduce`` call (simulations, netCDF files, figures);
 - ``process_s``: the whole process, interpreter start included (what
   ``time slidernet paper`` reports);
@@ -46,7 +46,7 @@ from typing import Any
 CHILD = """
 import json, sys, time
 t0 = time.perf_counter()
-from slidernet.paper import reproduce
+from slidernet.paper.reproduction import reproduce
 t1 = time.perf_counter()
 reproduce(sys.argv[1], quick=sys.argv[2] == "quick", progress=False)
 t2 = time.perf_counter()

@@ -53,9 +53,9 @@ import numpy as np
 from numba import njit
 
 from slidernet.config import load_config
+from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import AvalancheError
 from slidernet.kernels.vec import exact_slip, integrate_slip
-from slidernet.runner import realization_seeds
 from slidernet.solver import Realization, Scene
 
 MU_D = 0.5

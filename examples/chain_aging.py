@@ -5,7 +5,7 @@ driver ``gaussian_steps``. The figure shows the ensemble mean of mu_max
 against t (log axis) and the number of rearrangements n(t). For two sliders
 only the weaker one ever slips, so mu_max is exactly the largest of the
 n + 2 thresholds drawn so far: the exact law
-(:func:`slidernet.theory.mu_max_moments` at the measured mean n(t)) is drawn
+(:func:`slidernet.analysis.theory.mu_max_moments` at the measured mean n(t)) is drawn
 over the data. For every n the mean of the largest of n independent draws,
 the state at t = 0, is marked on the left edge.
 
@@ -34,7 +34,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import slidernet
-from slidernet import theory
+from slidernet.analysis import theory
 from slidernet.io import save_figure, write_netcdf
 
 MU_D = 0.5            # dynamic friction coefficient

@@ -15,7 +15,7 @@ starting at a = 0.55 > mu_d = 0.5 (so no truncation is needed):
 with z = (mu_max - a) / s, s each law's scale (0.1, 0.05, 0.05), so that
 the three share axes. The figure shows the ensemble mean of z against t,
 with the exact law -- the mean of the largest of n + 2 draws
-(:meth:`slidernet.distributions.TruncatedBelow.mean_max`) at each
+(:meth:`slidernet.plugins.distributions.TruncatedBelow.mean_max`) at each
 realization's measured n(t), averaged over the realizations, and (dotted)
 at the measured mean n(t) -- and the deviation of the data from the first in
 standard errors.

@@ -16,9 +16,9 @@ import time
 from pathlib import Path
 
 import slidernet
+from slidernet.analysis.plots import save_network_pictures
 from slidernet.config import load_config
 from slidernet.io import write_netcdf
-from slidernet.plots import save_network_pictures
 
 CONFIG = Path(__file__).with_name("lattice.toml")
 

@@ -9,8 +9,7 @@ stepping). Start with :func:`run`::
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
-
+from slidernet._version import __version__
 from slidernet.errors import (
     AvalancheError,
     CheckpointError,
@@ -21,12 +20,7 @@ from slidernet.errors import (
     TiltTestError,
     UnknownPluginError,
 )
-from slidernet.registry import register_distribution, register_driver
-
-try:
-    __version__ = version("slidernet")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
+from slidernet.plugins.registry import register_distribution, register_driver
 
 __all__ = [
     "AvalancheError",
@@ -45,23 +39,32 @@ __all__ = [
 ]
 
 
-_SUBMODULES = {"builders", "checkpoint", "distributions", "drivers", "dynamics", "execution", "io", "network",
-               "observables", "plots", "registry", "solver", "speed_error", "store", "sweep", "testing", "theory",
-               "units"}
+# Where each stage lives; the old flat names (slidernet.theory, slidernet.sweep, ...) still resolve.
+_SUBMODULES = {
+    "builders": "model.builders", "network": "model.network", "units": "model.units",
+    "distributions": "plugins.distributions", "drivers": "plugins.drivers", "registry": "plugins.registry",
+    "testing": "testing", "config": "config", "solver": "solver", "kernels": "kernels",
+    "observables": "analysis.observables", "theory": "analysis.theory", "plots": "analysis.plots",
+    "io": "io", "store": "io.store", "checkpoint": "io.checkpoint",
+    "runner": "ensemble.runner", "execution": "ensemble.execution", "sweep": "ensemble.sweep",
+    "paper": "paper", "dynamics": "validation.dynamics", "speed_error": "validation.speed_error",
+    "model": "model", "plugins": "plugins", "analysis": "analysis", "ensemble": "ensemble",
+    "validation": "validation",
+}
 
 
 def __getattr__(name: str):
     # Lazy: importing slidernet should not import numba and compile kernels.
     if name == "run":
-        from slidernet.runner import run
+        from slidernet.ensemble.runner import run
 
         return run
     if name == "load_config":
         from slidernet.config import load_config
 
         return load_config
-    if name in _SUBMODULES:  # slidernet.testing etc. without an explicit import, as in scipy
+    if name in _SUBMODULES:  # slidernet.theory etc. without an explicit import, as in scipy
         import importlib
 
-        return importlib.import_module(f"slidernet.{name}")
+        return importlib.import_module(f"slidernet.{_SUBMODULES[name]}")
     raise AttributeError(f"module 'slidernet' has no attribute {name!r}")

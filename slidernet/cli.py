@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 from slidernet.errors import RunInterrupted, SlidernetError, UnknownPluginError
 
 if TYPE_CHECKING:
-    from slidernet.registry import Registry
+    from slidernet.plugins.registry import Registry
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -78,7 +78,7 @@ def _parser() -> argparse.ArgumentParser:
 
     sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
 
-    from slidernet.units import MATERIALS
+    from slidernet.model.units import MATERIALS
 
     u = sub.add_parser(
         "units", help="turn a material and a setup into Ntilde, sigma_theta and tau_th",
@@ -121,7 +121,7 @@ def _execution_flags(p: argparse.ArgumentParser) -> None:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
-    from slidernet.runner import run
+    from slidernet.ensemble.runner import run
 
     cfg = load_config(args.config)  # validate before any work or any file
     with run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
@@ -131,7 +131,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from slidernet.sweep import parse_grid, sweep
+    from slidernet.ensemble.sweep import parse_grid, sweep
 
     ds = sweep(args.config, parse_grid(args.sets), progress=_progress(args), out=args.out,
                resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
@@ -142,7 +142,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
-    from slidernet.paper import reproduce
+    from slidernet.paper.reproduction import reproduce
 
     files = reproduce(args.out, quick=args.quick, progress=_progress(args), resume=args.resume,
                       overwrite=args.overwrite)
@@ -152,7 +152,7 @@ def _cmd_paper(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from slidernet.speed_error import speed_error
+    from slidernet.validation.speed_error import speed_error
 
     files = speed_error(args.out, quick=args.quick, progress=_progress(args))
     for name, path in files.items():
@@ -161,7 +161,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
-    from slidernet import registry
+    from slidernet.plugins import registry
 
     for reg in (registry.distributions, registry.drivers):
         print(f"{reg.kind}s ({reg.group}):")
@@ -190,7 +190,7 @@ def _summary(factory: object) -> str:
 
 
 def _cmd_units(args: argparse.Namespace) -> int:
-    from slidernet.units import setup
+    from slidernet.model.units import setup
 
     values = {k: getattr(args, k) for k in ("rho", "Y", "alpha", "conductivity", "heat_capacity")}
     result = setup(args.material, size=args.size, delta_T=args.delta_T, g=args.g, **values)

@@ -30,11 +30,14 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
-from slidernet import registry, units
-from slidernet.distributions import TruncatedBelow
 from slidernet.errors import ConfigError, SlidernetError
+from slidernet.model import units
+from slidernet.model.network import Network
+from slidernet.plugins import registry
+from slidernet.plugins.distributions import TruncatedBelow
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -145,7 +148,7 @@ class UnitsConfig(_Strict):
     (Pa), ``alpha`` (1/K), ``conductivity`` (W/(m K)), ``heat_capacity``
     (J/(kg K)); the slider ``size`` l0 (m); the temperature amplitude
     ``delta_T`` (K, optional); gravity ``g`` (m/s^2, default 9.81). See
-    :mod:`slidernet.units` for the formulas (Ntilde = rho g l0 / Y,
+    :mod:`slidernet.model.units` for the formulas (Ntilde = rho g l0 / Y,
     sigma_theta = alpha delta_T).
 
     The table fills ``network.Ntilde`` when [network] has none, and, when
@@ -413,8 +416,6 @@ class Config(_Strict):
         """(dimension, runs on the pair kernel) of the network, reading a graph file only if there is one."""
         net = self.network
         if net.kind == "graph":
-            from slidernet.solver import build_network
-
             try:
                 built = build_network(self)
             except (SlidernetError, OSError):
@@ -589,3 +590,14 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
 def is_finite(x: float) -> bool:
     """True for a finite float (helper for plugin validation)."""
     return math.isfinite(x)
+
+
+def build_network(cfg: Config) -> Network:
+    """The network of the configured scene (its own seed: the geometry is quenched)."""
+    from slidernet.model.builders import build
+
+    net_cfg = cfg.network
+    params = net_cfg.model_dump(exclude={"kind", "Ntilde", "seed"}, exclude_none=True)
+    # seed None means 0, not fresh entropy: a network is part of the scene.
+    rng = np.random.Generator(np.random.PCG64(net_cfg.seed or 0))
+    return build(net_cfg.kind, params, net_cfg.Ntilde, rng)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from slidernet import registry
 from slidernet.config import load_config
+from slidernet.plugins import registry
 from slidernet.solver import Realization, Scene
 
 # No hypothesis example may fail for taking long: the suite runs on slow and loaded machines too.

@@ -2,7 +2,7 @@
 
 ``solver.batch`` only sets how many draws the kernels get per refill of their
 buffers. The thresholds are the values of a
-:class:`~slidernet.distributions.TruncatedStream` (fixed raw chunks of the
+:class:`~slidernet.plugins.distributions.TruncatedStream` (fixed raw chunks of the
 plugin, filtered at mu_d, surplus kept), so even where the truncation below
 mu_d rejects many draws the values, and the results, are the same bits for
 every batch size, 1 included.
@@ -19,10 +19,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import slidernet
-from slidernet import distributions
 from slidernet.config import load_config
-from slidernet.distributions import RAW_CHUNK, Gaussian, TruncatedBelow, TruncatedStream
 from slidernet.errors import ConfigError, PluginError
+from slidernet.plugins import distributions
+from slidernet.plugins.distributions import RAW_CHUNK, Gaussian, TruncatedBelow, TruncatedStream
 from slidernet.solver import Realization, Scene, realization_streams, simulate
 from tests.conftest import make_config
 

@@ -1,4 +1,4 @@
-"""Tests of slidernet.builders: lattices, Delaunay networks, graph files and the build dispatch.
+"""Tests of slidernet.model.builders: lattices, Delaunay networks, graph files and the build dispatch.
 
 Geometry and linear-elasticity checks (MODEL.md section 2): lattice springs all
 have length 1, the thermal load g = B^T (k L kappa) vanishes on interior nodes
@@ -18,7 +18,7 @@ import pytest
 import scipy.spatial
 
 from slidernet import ConfigError
-from slidernet.builders import (
+from slidernet.model.builders import (
     KINDS,
     build,
     from_graph,
@@ -28,7 +28,7 @@ from slidernet.builders import (
     triangular,
     write_graph,
 )
-from slidernet.network import Network, chain
+from slidernet.model.network import Network, chain
 
 NT = 1e-7
 LATTICES = {"square": square, "triangular": triangular}

@@ -11,11 +11,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-from slidernet import distributions, kernels, solver
-from slidernet.checkpoint import checkpoint_info, load_realization, save_realization
+from slidernet import kernels
 from slidernet.config import load_config
 from slidernet.errors import CheckpointError
+from slidernet.io.checkpoint import checkpoint_info, load_realization, save_realization
+from slidernet.plugins import distributions
 from slidernet.solver import Realization, Scene, simulate
+from slidernet.solver import realization as realization_module
 
 from .conftest import make_config
 
@@ -55,7 +57,7 @@ pytestmark = pytest.mark.filterwarnings("ignore:The event catalogue reached solv
 @pytest.fixture(autouse=True)
 def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     # Catalogue chunks of 64 rows: several are handed to Python before the checkpoint.
-    monkeypatch.setattr(solver, "EVENT_CHUNK", 64)
+    monkeypatch.setattr(realization_module, "EVENT_CHUNK", 64)
     # Raw threshold chunks of 64 draws: the streams' Generators have moved past
     # their first chunk, and hold a surplus, at the checkpoint.
     monkeypatch.setattr(distributions, "RAW_CHUNK", 64)
@@ -271,7 +273,7 @@ def test_a_failed_save_leaves_the_previous_checkpoint_and_no_temporary_file(
 def test_state_this_module_does_not_know_is_refused(tmp_path: Path) -> None:
     real = Realization(fresh_scene("pair_tilt"), np.random.SeedSequence(11))
     real.new_state = np.zeros(3)
-    with pytest.raises(CheckpointError, match=r"\['new_state'\] that slidernet.checkpoint neither saves"):
+    with pytest.raises(CheckpointError, match=r"\['new_state'\] that slidernet.io.checkpoint neither saves"):
         save_realization(real, tmp_path / "r.npz", META)
     assert not (tmp_path / "r.npz").exists()
 

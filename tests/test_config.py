@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import slidernet
-from slidernet import ConfigError, UnknownPluginError, distributions, drivers, registry
+from slidernet import ConfigError, UnknownPluginError
 from slidernet.config import Config, load_config
+from slidernet.plugins import distributions, drivers, registry
 from tests.conftest import REFERENCE, make_config
 
 if sys.version_info >= (3, 11):

@@ -7,13 +7,13 @@ import pytest
 
 import slidernet
 from slidernet import kernels
-from slidernet.builders import triangular
 from slidernet.config import load_config
-from slidernet.distributions import Gaussian, TruncatedBelow
+from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import ConfigError
 from slidernet.kernels.tilt_net import N_POS, P_MU, P_U, tilt_test_network
-from slidernet.network import Network, chain
-from slidernet.runner import realization_seeds
+from slidernet.model.builders import triangular
+from slidernet.model.network import Network, chain
+from slidernet.plugins.distributions import Gaussian, TruncatedBelow
 from slidernet.solver import Realization, Scene
 
 from .conftest import make_config
@@ -276,7 +276,7 @@ def test_f_ext_shapes(value, expected):
 
 
 def test_f_ext_survives_a_graphml_round_trip(tmp_path):
-    from slidernet.builders import from_graph, read_graph, write_graph
+    from slidernet.model.builders import from_graph, read_graph, write_graph
 
     net = triangular((3, 3), Ntilde=1e-7, f_ext=[0.05, -0.01])
     (path,) = write_graph(net, tmp_path / "net.graphml")

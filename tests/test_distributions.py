@@ -18,9 +18,11 @@ from hypothesis import strategies as st
 from scipy import stats
 
 import slidernet
-from slidernet import registry, theory
+from slidernet.analysis import theory
 from slidernet.config import load_config
-from slidernet.distributions import (
+from slidernet.errors import ConfigError
+from slidernet.plugins import registry
+from slidernet.plugins.distributions import (
     BUILTINS,
     MIN_MASS,
     Distribution,
@@ -35,7 +37,6 @@ from slidernet.distributions import (
     Weibull,
     mean_max_quadrature,
 )
-from slidernet.errors import ConfigError
 from tests.conftest import make_config
 from tests.test_examples import load_example
 

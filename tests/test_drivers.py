@@ -12,8 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import slidernet
-from slidernet import ConfigError, registry
-from slidernet.drivers import BUILTINS, GaussianSteps, OrnsteinUhlenbeck, Ramp, Series, Sinusoidal
+from slidernet import ConfigError
+from slidernet.plugins import registry
+from slidernet.plugins.drivers import BUILTINS, GaussianSteps, OrnsteinUhlenbeck, Ramp, Series, Sinusoidal
 from tests.conftest import make_config
 
 # A series of 101 samples every 30 s (times 0 ... 3000 s): with tau_th = 60 s it covers 50 steps.

@@ -1,4 +1,4 @@
-"""The reference integrator of the equations of motion (slidernet.dynamics) against closed forms and the solver.
+"""The reference integrator of the equations of motion (validation.dynamics) against closed forms and the solver.
 
 Every run is deterministic (fixed seeds); each test states its tolerance and why.
 """
@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from slidernet.config import load_config
-from slidernet.dynamics import Dynamics, realization_draws
 from slidernet.errors import AvalancheError, ConfigError
-from slidernet.network import chain
+from slidernet.model.network import chain
 from slidernet.solver import Realization, Scene, simulate
+from slidernet.validation.dynamics import Dynamics, realization_draws
 
 Ntilde = 1e-7
 MU_D = 0.5

@@ -28,10 +28,11 @@ from hypothesis import strategies as st
 from scipy import special, stats
 
 import slidernet
-from slidernet import kernels, theory
+from slidernet import kernels
+from slidernet.analysis import theory
+from slidernet.analysis.observables import assemble
 from slidernet.config import load_config
 from slidernet.io import read_result, write_netcdf
-from slidernet.observables import assemble
 from slidernet.solver import Realization, Scene, simulate
 from tests.conftest import make_config, realization_of, scene_of
 
@@ -514,7 +515,7 @@ class CountedDraws:
 
     ``records`` counts the draws above the running maximum of all draws before
     them (the first ``n_initial``, the initial thresholds, set it and are no
-    records). The stream (:class:`~slidernet.distributions.TruncatedStream`)
+    records). The stream (:class:`~slidernet.plugins.distributions.TruncatedStream`)
     and the kernel's buffer hold at most a batch and a chunk of draws not yet
     used, so all but the last ``KEEP`` chunks are scanned as they come (a
     billion draws are never held at once); :meth:`used` scans the rest up to

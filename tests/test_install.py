@@ -25,7 +25,7 @@ PACKAGE = Path(slidernet.__file__).parent
 # Compiles (or loads from the cache) a small cached kernel of the package.
 SNIPPET = """
 import numpy as np
-from slidernet.drivers import _ar1_in_place
+from slidernet.plugins.drivers import _ar1_in_place
 y = np.ones(4)
 _ar1_in_place(y, 0.5)
 assert y[-1] == 1.875
@@ -62,6 +62,6 @@ def test_another_packages_numba_cache_is_left_alone(tmp_path):
     """Only slidernet's functions are redirected: numba's own setting is restored after each decoration."""
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env["XDG_CACHE_HOME"] = str(tmp_path)
-    code = "import numba, slidernet.drivers; print(repr(numba.config.CACHE_DIR))"
+    code = "import numba, slidernet.plugins.drivers; print(repr(numba.config.CACHE_DIR))"
     out = subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True, text=True)
     assert out.stdout.strip() == "''"

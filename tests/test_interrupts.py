@@ -195,9 +195,9 @@ def test_ctrl_c_stops_a_run_on_a_dask_cluster(tmp_path, config, reference, monke
 
     distributed = pytest.importorskip("distributed")
     import slidernet
-    from slidernet import registry
     from slidernet.config import tomllib
     from slidernet.errors import RunInterrupted
+    from slidernet.plugins import registry
 
     spec = importlib.util.spec_from_file_location("gated_cli", GATED_CLI)
     gated = importlib.util.module_from_spec(spec)

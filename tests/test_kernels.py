@@ -14,7 +14,7 @@ import pytest
 
 import slidernet
 from slidernet import AvalancheError, kernels
-from slidernet.distributions import Gaussian, TruncatedBelow
+from slidernet.plugins.distributions import Gaussian, TruncatedBelow
 from slidernet.solver import Realization, realization_streams, simulate
 from tests.conftest import make_config, realization_of, scene_of
 

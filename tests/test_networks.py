@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from slidernet.builders import triangular
 from slidernet.config import load_config
 from slidernet.kernels.vec import critical_thetas, exact_slip
-from slidernet.network import Network
+from slidernet.model.builders import triangular
+from slidernet.model.network import Network
 from slidernet.solver import Realization, Scene
 
 from .conftest import make_config

@@ -75,7 +75,7 @@ class _Broken:
 
 @pytest.mark.parametrize("existing", [False, True], ids=["new-folder", "folder-with-files"])
 def test_a_run_that_fails_before_any_work_leaves_the_folder_as_found(tmp_path, existing, monkeypatch):
-    from slidernet import registry
+    from slidernet.plugins import registry
 
     monkeypatch.setitem(registry.distributions._runtime, "broken_for_test", _Broken)
     out = tmp_path / "out"

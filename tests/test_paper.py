@@ -10,7 +10,7 @@ import xarray as xr
 
 import slidernet
 from slidernet.io import read_result
-from slidernet.paper import FULL, QUICK, Preset, _config, reproduce
+from slidernet.paper.reproduction import FULL, QUICK, Preset, _config, reproduce
 
 TINY = Preset(
     name="tiny",
@@ -115,8 +115,9 @@ def test_presets_use_the_captions_parameters():
 def test_an_interrupted_reproduction_resumes_to_the_same_figures(tmp_path, tiny_output, monkeypatch):
     import signal
 
-    from slidernet import paper, runner
+    from slidernet.ensemble import runner
     from slidernet.errors import CheckpointError, OutputError, RunInterrupted
+    from slidernet.paper import reproduction as paper
 
     real_run_in = paper.run_in
     calls = []

@@ -13,12 +13,19 @@ from matplotlib.collections import PathCollection
 from matplotlib.figure import Figure
 
 import slidernet
-from slidernet.builders import triangular
+from slidernet.analysis.plots import (
+    EDGE_LIMIT,
+    mu_s_field,
+    network_of,
+    node_field,
+    save_network_pictures,
+    slip_map,
+)
 from slidernet.config import load_config
 from slidernet.errors import ConfigError
 from slidernet.io import read_result, write_netcdf
-from slidernet.network import chain
-from slidernet.plots import EDGE_LIMIT, mu_s_field, network_of, node_field, save_network_pictures, slip_map
+from slidernet.model.builders import triangular
+from slidernet.model.network import chain
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -21,9 +21,10 @@ import numpy as np
 import pytest
 
 import slidernet
-from slidernet import PluginError, UnknownPluginError, distributions, drivers, registry
+from slidernet import PluginError, UnknownPluginError
 from slidernet.cli import main
 from slidernet.config import load_config
+from slidernet.plugins import distributions, drivers, registry
 from slidernet.testing import (
     DEFAULT_MU_D,
     PluginContractError,
@@ -85,11 +86,11 @@ def test_every_builtin_has_an_example_so_the_contract_test_never_skips_it(reg, n
 
 
 def test_the_shipped_example_files_are_what_their_note_says(tmp_path, monkeypatch):
-    # slidernet/data/README.md holds the script that made them: rerun it and compare bytes.
+    # slidernet/plugins/data/README.md holds the script that made them: rerun it and compare bytes.
     note = Path(example_file("README.md")).read_text(encoding="utf-8")
     script = re.search(r"```python\n(.*?)```", note, re.S).group(1)
     monkeypatch.chdir(tmp_path)
-    exec(compile(script, "slidernet/data/README.md", "exec"), {})
+    exec(compile(script, "slidernet/plugins/data/README.md", "exec"), {})
     for name in ("mu_s_example.txt", "temperature_example.csv"):
         assert (tmp_path / name).read_bytes() == Path(example_file(name)).read_bytes(), name
 
@@ -341,8 +342,8 @@ def test_plugin_returning_nan_is_stopped_naming_it(kind, clean_registries):
         )
 
 
-MODULE_PATHS = ["os:system", "pkg.mod:Class", "slidernet.distributions:Gaussian", "tests.plugin_fixtures:FakeDist",
-                "this:s", "subprocess.run", "builtins:eval"]
+MODULE_PATHS = ["os:system", "pkg.mod:Class", "slidernet.plugins.distributions:Gaussian",
+                "tests.plugin_fixtures:FakeDist", "this:s", "subprocess.run", "builtins:eval"]
 
 
 @pytest.mark.parametrize("path", MODULE_PATHS)

@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 import slidernet
-from slidernet import theory
+from slidernet.analysis import theory
 from tests.test_statistics import rule_rate
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -74,6 +74,6 @@ def test_plugin_example_runs_as_written(clean_registries):
     text = README.read_text(encoding="utf-8").split("**Your own plugin.**", 1)[1]
     code = re.search(r"```python\n(.*?)```", text, re.S).group(1)
     exec(compile(code, "README.md", "exec"), {})
-    from slidernet import registry
+    from slidernet.plugins import registry
 
     assert registry.distributions.origin("my_uniform") == "run time"

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import slidernet
-from slidernet import PluginError, UnknownPluginError, distributions, drivers, registry
+from slidernet import PluginError, UnknownPluginError
 from slidernet.config import load_config
+from slidernet.plugins import distributions, drivers, registry
 from tests.conftest import FixedThetas, make_config
 from tests.plugin_fixtures import FakeDist, NanDist, ShortDriver
 
@@ -134,7 +135,7 @@ def test_distribution_of_wrong_shape_is_named(clean_registries):
 
     slidernet.register_distribution("scalar", Scalar)
     # The solver asks a plugin for fixed raw chunks of RAW_CHUNK draws (batch-independent streams).
-    from slidernet.distributions import RAW_CHUNK
+    from slidernet.plugins.distributions import RAW_CHUNK
 
     with pytest.raises(PluginError, match=rf"'scalar' returned shape \(\) from sample\(rng, {RAW_CHUNK}\); "
                                           rf"expected \({RAW_CHUNK},\)"):

@@ -9,9 +9,9 @@ import itertools
 import numpy as np
 import pytest
 
-from slidernet import speed_error as se
 from slidernet.cli import main
 from slidernet.solver import Realization, horizontal_draws, realization_streams
+from slidernet.validation import speed_error as se
 
 
 @pytest.fixture(scope="module")

@@ -13,8 +13,8 @@ import pytest
 from scipy import stats
 
 import slidernet
+from slidernet.analysis.theory import mean_rearrangements, mean_records, mu_max_cdf
 from slidernet.solver import Realization, horizontal_draws, realization_streams
-from slidernet.theory import mean_rearrangements, mean_records, mu_max_cdf
 from tests.conftest import make_config, scene_of
 
 NTILDE = 1e-7

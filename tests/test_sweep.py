@@ -13,13 +13,13 @@ import pytest
 import xarray as xr
 
 import slidernet
-from slidernet import runner
+from slidernet.ensemble import runner
+from slidernet.ensemble.sweep import _dim_names, parse_grid, parse_set, sweep
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
 from slidernet.io import read_result
-from slidernet.sweep import _dim_names, parse_grid, parse_set, sweep
 
-# sys.modules' entry: ``slidernet.sweep`` may name the function once the package exports it.
-sweep_module = importlib.import_module("slidernet.sweep")
+# sys.modules' entry: ``slidernet.ensemble.sweep`` may name the function once the package exports it.
+sweep_module = importlib.import_module("slidernet.ensemble.sweep")
 
 BASE: dict[str, Any] = {
     "seed": 3,
@@ -305,7 +305,7 @@ def test_a_killed_sweep_resumes_to_the_same_bits(tmp_path, monkeypatch):
 
 def test_the_paper_figure_3b_sweep_fills_its_progress_bar(tmp_path):
     # paper.reproduce drives one bar over every job; the sweep of panel b must add exactly its jobs' cost.
-    from slidernet.paper import _config, _Job, _Runner
+    from slidernet.paper.reproduction import _config, _Job, _Runner
 
     jobs = [_Job(f"sweep_sigma_theta={s:g}", _config(s, 50, 2, 201, observables=("n",))) for s in (1e-7, 1e-6)]
     bar_owner = _Runner(jobs, progress=True, runs=tmp_path, resume=False)

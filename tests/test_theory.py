@@ -1,4 +1,4 @@
-"""Tests of slidernet.theory: exact identities, Monte Carlo checks, validation."""
+"""Tests of slidernet.analysis.theory: exact identities, Monte Carlo checks, validation."""
 
 from __future__ import annotations
 
@@ -10,9 +10,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special, stats
 
-from slidernet.distributions import Gaussian, TruncatedBelow
-from slidernet.errors import ConfigError
-from slidernet.theory import (
+from slidernet.analysis.theory import (
     harmonic,
     mean_rearrangements,
     mean_records,
@@ -21,6 +19,8 @@ from slidernet.theory import (
     mu_max_leading,
     mu_max_moments,
 )
+from slidernet.errors import ConfigError
+from slidernet.plugins.distributions import Gaussian, TruncatedBelow
 
 MU_D = 0.5
 MU_S_MEAN = 0.6

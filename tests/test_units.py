@@ -1,4 +1,4 @@
-"""slidernet.units: from a material and a setup to Ntilde, sigma_theta and tau_th (the paper, section V)."""
+"""slidernet.model.units: from a material and a setup to Ntilde, sigma_theta and tau_th (the paper, section V)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,13 @@ import numpy as np
 import pytest
 
 import slidernet
-from slidernet import ConfigError, registry, theory, units
+from slidernet import ConfigError
+from slidernet.analysis import theory
 from slidernet.cli import main
 from slidernet.config import load_config
 from slidernet.io import result_config
+from slidernet.model import units
+from slidernet.plugins import registry
 from tests.conftest import FixedThetas, make_config
 
 if sys.version_info >= (3, 11):

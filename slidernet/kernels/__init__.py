@@ -1,6 +1,6 @@
 """Compiled event-driven kernels (numba), one per scene.
 
-Units are the internal ones of :mod:`slidernet.network`: forces in N,
+Units are the internal ones of :mod:`slidernet.model.network`: forces in N,
 stiffnesses in k0 = N/(Ntilde l0), lengths in Ntilde l0, and theta enters as
 theta/Ntilde. In these units the paper's spring has k = 1, so equation
 `critique` reads theta_c = u + mu_min s and equation `displacement` reads

@@ -1,7 +1,7 @@
 """Write the golden result files that tests/test_golden.py requires the code to reproduce bit for bit.
 
 Each case is one configuration run through the public API (``slidernet.run``
-or ``slidernet.sweep.sweep``) and written with ``slidernet.io.write_netcdf``.
+or ``slidernet.ensemble.sweep.sweep``) and written with ``slidernet.io.write_netcdf``.
 The files were made with this script on main at commit a0cadef plus this script (before the
 package was split into layered folders), on Linux x86_64 with numpy 2.4,
 numba 0.68 and Python 3.11:
@@ -19,8 +19,8 @@ from pathlib import Path
 from typing import Any
 
 import slidernet
+from slidernet.ensemble.sweep import sweep
 from slidernet.io import write_netcdf
-from slidernet.sweep import sweep
 
 HERE = Path(__file__).parent
 STATIC = {"name": "gaussian", "mean": 0.6, "std": 0.01}

@@ -8,7 +8,8 @@ from scipy import special
 from slidernet_bimodal import Bimodal
 
 import slidernet
-from slidernet import ConfigError, registry
+from slidernet import ConfigError
+from slidernet.plugins import registry
 from slidernet.testing import check_distribution
 
 PARAMS = Bimodal.example_params

@@ -9,7 +9,8 @@ import pytest
 from slidernet_telegraph import Telegraph
 
 import slidernet
-from slidernet import ConfigError, registry
+from slidernet import ConfigError
+from slidernet.plugins import registry
 from slidernet.testing import check_driver
 
 

@@ -13,13 +13,14 @@ import numpy as np
 import xarray as xr
 from tqdm.auto import tqdm
 
-import slidernet
+from slidernet._version import __version__
+from slidernet.analysis.observables import CHUNK, assemble
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
+from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
+from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import CheckpointError, RunInterrupted, param_error
-from slidernet.execution import StopSignal, available_cores, execute, scene_of
-from slidernet.io import read_result, write_result_stream
-from slidernet.observables import CHUNK, assemble
-from slidernet.store import RunStore
+from slidernet.io import read_result
+from slidernet.io.store import RunStore
 
 
 def resolve_seed(cfg: Config) -> Config:
@@ -38,14 +39,14 @@ def identity(requested: Config, resolved: Config) -> dict[str, Any]:
     """What a checkpoint must match to be resumed: the config without its execution table, the seed, R."""
     config = requested.model_dump(mode="json", exclude={"execution"})
     return {"config": config, "seed": resolved.seed, "realizations": resolved.realizations,
-            "slidernet_version": slidernet.__version__}
+            "slidernet_version": __version__}
 
 
 def _attrs(cfg: Config, kernel: str, workers: int, scheduler: str | None) -> dict[str, str]:
     return {
         "config": json.dumps(cfg.model_dump(mode="json", exclude={"execution"}), sort_keys=True),
         "execution": json.dumps({"workers": workers, "scheduler": scheduler}),
-        "slidernet_version": slidernet.__version__,
+        "slidernet_version": __version__,
         "seed": str(cfg.seed),
         "kernel": kernel,
         "Conventions": "CF-1.8",
@@ -183,7 +184,7 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
     """Run the realizations not ``done``; records kept in memory, or in ``store`` (flushed as they come).
 
     Ctrl-C and SIGTERM stop the run at a clean point of every running
-    realization (see :class:`slidernet.execution.StopSignal`): the work is
+    realization (see :class:`slidernet.ensemble.execution.StopSignal`): the work is
     saved in ``store`` and :class:`RunInterrupted` says how to resume.
     """
     ex = cfg.execution

@@ -3,7 +3,7 @@
 Between two calls of :meth:`Realization.advance` a realization is at a clean
 point: its whole state is in arrays, in the states of its random streams and
 in the surplus of its threshold streams (the accepted draws a
-:class:`~slidernet.distributions.TruncatedStream` has drawn but not yet
+:class:`~slidernet.plugins.distributions.TruncatedStream` has drawn but not yet
 handed out). :func:`save_realization` writes that state to one ``.npz`` file
 (numpy's zip of ``.npy`` arrays; nothing is pickled) and
 :func:`load_realization` rebuilds the realization from its scene and seed and
@@ -124,7 +124,7 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
     unknown = sorted(set(vars(real)) - _SAVED - set(_REBUILT))
     if unknown:
         raise CheckpointError(
-            f"The realization holds {unknown} that slidernet.checkpoint neither saves nor rebuilds; "
+            f"The realization holds {unknown} that slidernet.io.checkpoint neither saves nor rebuilds; "
             "add each to checkpoint._SAVED (and save it) or to checkpoint._REBUILT."
         )
     network = real.scene.kernel != "pair"

@@ -55,6 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import special, stats
 
+from slidernet._validation import checked_output
 from slidernet.errors import ConfigError, param_error
 
 # The least probability a law may put above mu_d (check_mu_d): rejection
@@ -989,7 +990,7 @@ class TruncatedBelow:
         return 1.0 - np.asarray(self.dist.cdf(x), dtype=float)
 
     def _checked(self, draws: object, size: int) -> np.ndarray:
-        from slidernet.registry import checked_output
+
 
         return checked_output(draws, (size,), "distribution", self.name, f"sample(rng, {size})")
 
@@ -1151,7 +1152,7 @@ class TruncatedStream:
     are therefore the filtered raw chunks laid end to end, a function of the
     Generator's initial state alone: asking one at a time or 65536 at a time
     gives the same bits. Its state is the Generator's state plus
-    :attr:`surplus` (what :mod:`slidernet.checkpoint` saves).
+    :attr:`surplus` (what :mod:`slidernet.io.checkpoint` saves).
 
     Nothing is drawn before the first :meth:`take`. For a plugin whose
     ``sample`` is prefix-consistent (``sample(rng, a)`` then ``sample(rng, b)``

@@ -10,9 +10,9 @@ method             what changes
 =================  ============================================================
 event-driven       the solver (pair kernel, and the general CSR kernel): exact
 fixed-step         a naive theta sweep that checks stability every dtheta
-                   (:mod:`slidernet.kernels.fixed_step`)
+                   (:mod:`slidernet.validation.fixed_step`)
 dynamics           the equations of motion with inertia and Coulomb friction
-                   (:mod:`slidernet.dynamics`), at several tau_dyn/tau_th
+                   (:mod:`slidernet.validation.dynamics`), at several tau_dyn/tau_th
 dynamics, chain    the same on a chain of 4 sliders, where several sliders can
                    move at once and the quasi-static rule itself is the error
 2D slip            the straight-line slip against the exactly integrated one
@@ -151,7 +151,7 @@ def fixed_step_final(scene: Scene, seeds: list[np.random.SeedSequence], dtheta: 
     dtheta : float
         Largest sub-step of theta, in units of Ntilde.
     """
-    from slidernet.kernels.fixed_step import AVALANCHE_LIMIT, OUT_OF_DRAWS, sweep_pair
+    from slidernet.validation.fixed_step import AVALANCHE_LIMIT, OUT_OF_DRAWS, sweep_pair
 
     out: dict[str, list[float]] = {"n": [], "mu_max": [], "x_G": []}
     rec = scene.rec_times
@@ -179,7 +179,7 @@ def _solver_final(scene: Scene, seeds: list[np.random.SeedSequence]) -> Final:
 
 def _dynamics_final(scene: Scene, seeds: list[np.random.SeedSequence], tau_ratio: float,
                     max_step: float) -> Final:
-    from slidernet.dynamics import Dynamics
+    from slidernet.validation.dynamics import Dynamics
 
     dyn = Dynamics(scene, tau_ratio=tau_ratio, max_step=max_step)
     return _final([dyn.run(ss) for ss in seeds])
@@ -187,7 +187,7 @@ def _dynamics_final(scene: Scene, seeds: list[np.random.SeedSequence], tau_ratio
 
 def _warm_up() -> None:
     """Load every compiled kernel once, so that no timing includes numba's cache loading."""
-    from slidernet.kernels.fixed_step import sweep_pair
+    from slidernet.validation.fixed_step import sweep_pair
 
     tiny = _scene({**PAIR, "steps": 2, "record": [0, 2]})
     ss = [np.random.SeedSequence(0)]

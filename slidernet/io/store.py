@@ -8,7 +8,7 @@ Layout of ``DIR/checkpoint/`` (plain numeric files and JSON; no pickle)::
     block-<first>-<k>.npz    finished realizations, written together: their
                              indices, then every record stacked (ragged records,
                              the event catalogue, concatenated with offsets)
-    partial-<r>.npz          a realization in progress (slidernet.checkpoint)
+    partial-<r>.npz          a realization in progress (slidernet.io.checkpoint)
 
 Every file is written to a temporary name and renamed, so a kill at any time
 leaves either the old file or the new one. The set of finished realizations is

@@ -1,6 +1,6 @@
 """Builders of slider networks: lattices, random Delaunay networks and graph files.
 
-Every builder returns a :class:`slidernet.network.Network`. Positions are in
+Every builder returns a :class:`slidernet.model.network.Network`. Positions are in
 l0 (the natural spring length of the paper), so that on the lattices every
 spring has length 1. Node and edge orders are deterministic: nodes are
 numbered row by row (``index = row * cols + col``) on lattices and in draw
@@ -8,7 +8,7 @@ order for :func:`irregular`; springs are listed as pairs ``(i, j)`` with
 ``i < j``, sorted lexicographically.
 
 Keyword ``overrides`` (``k``, ``kappa``, ``normal_load``, ``rest_length``) are
-passed on to :class:`~slidernet.network.Network`: a scalar for every spring
+passed on to :class:`~slidernet.model.network.Network`: a scalar for every spring
 (or slider), or an array with one value per spring (shape (E,)) or per slider
 (shape (N,)), in that network's order. ``f_ext``, the constant external force
 on each slider, is a number (along x), a d-vector, or one per slider (N, d).
@@ -43,7 +43,7 @@ import numpy as np
 import scipy.spatial
 
 from slidernet.errors import ConfigError, param_error
-from slidernet.network import Network, chain
+from slidernet.model.network import Network, chain
 
 __all__ = [
     "KINDS",
@@ -327,7 +327,7 @@ def from_graph(G: nx.Graph, Ntilde: float, **overrides: Any) -> Network:
     """A network from a networkx graph whose nodes carry positions (in l0).
 
     Same as :meth:`Network.from_networkx
-    <slidernet.network.Network.from_networkx>`: node positions are the
+    <slidernet.model.network.Network.from_networkx>`: node positions are the
     ``pos`` attribute (1 or 2 floats) or ``x`` (and ``y``); optional
     ``normal_load`` on nodes and ``k``, ``kappa``, ``rest_length`` on edges.
     Nodes are numbered in ``G.nodes`` order, springs in ``G.edges`` order

@@ -3,7 +3,7 @@
 :func:`reproduce` runs the two-slider model at the captions' parameters
 (mu_d = 0.5, mean mu_s = 0.6, sigma_mu = 0.01, Ntilde = 1e-7, sigma_theta
 from 1e-7 to 1e-5; MODEL.md section 1), overlays the closed forms of
-:mod:`slidernet.theory` and writes, in ``out_dir``:
+:mod:`slidernet.analysis.theory` and writes, in ``out_dir``:
 
 =========================  ====================================================
 ``fig1_aging.png/.nc``     mu_max vs t (paper's Fig. ``aging``)
@@ -21,7 +21,7 @@ curves drawn on the figure as variables. Run it from the command line with
 The simulations are those of :func:`slidernet.run` (same seeds, same
 dataset), driven realization by realization so that a single progress bar
 covers the whole reproduction. Panel b of figure 3 is one
-:func:`slidernet.sweep.sweep` over sigma_theta: every point runs with the
+:func:`slidernet.ensemble.sweep.sweep` over sigma_theta: every point runs with the
 same seed (common random numbers).
 """
 
@@ -43,13 +43,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from tqdm.auto import tqdm
 
-import slidernet
-from slidernet import theory
+from slidernet._version import __version__
+from slidernet.analysis import theory
 from slidernet.config import load_config
+from slidernet.ensemble.runner import run_in
+from slidernet.ensemble.sweep import sweep as run_sweep
 from slidernet.errors import CheckpointError, OutputError, RunInterrupted
 from slidernet.io import write_netcdf
-from slidernet.runner import run_in
-from slidernet.sweep import sweep as run_sweep
 
 __all__ = ["FULL", "QUICK", "Preset", "reproduce"]
 
@@ -169,7 +169,7 @@ class _Runner:
                       on_realization=lambda _: self.bar.update(step))
 
     def sweep(self, jobs: list[_Job], key: str, label: str) -> xr.Dataset:
-        """One :func:`slidernet.sweep.sweep` over ``key``: point i is ``jobs[i]`` (same config but ``key``)."""
+        """One sweep (:func:`~slidernet.ensemble.sweep.sweep`) over ``key``: point i is ``jobs[i]``."""
         values = [_get(j.config, key) for j in jobs]
         steps = [_cost_per_realization(j.config) for j in jobs]
 
@@ -214,7 +214,7 @@ def _file_attrs(title: str, labels: list[str], runs: list[xr.Dataset]) -> dict[s
         "title": title,
         "source": PAPER,
         "configs": _configs_attr(labels, runs),
-        "slidernet_version": slidernet.__version__,
+        "slidernet_version": __version__,
         "Conventions": "CF-1.8",
     }
 
@@ -559,7 +559,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
     job3a = _Job(f"panel_a_sigma_theta={p.fig3a_sigma:g}",
                  _config(p.fig3a_sigma, p.fig3a_steps, p.fig3a_realizations, p.seed + 100, observables=("n",),
                          record=t_lin))
-    # One sweep: every sigma_theta runs with the same seed (common random numbers, slidernet.sweep).
+    # One sweep: every sigma_theta runs with the same seed (common random numbers, slidernet.ensemble.sweep).
     jobs3b = [_Job(f"sweep_sigma_theta={s:.4g}", _config(s, p.fig3b_steps, p.fig3b_realizations, p.seed + 200,
                                                          observables=("n",)))
               for s in p.fig3b_sigmas]
@@ -639,7 +639,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
             "fig3b": {j.label: float(r) for j, r in zip(jobs3b, sweep3b["r_mean"].values, strict=True)},
             "fig4": {j.label: float(r["r_mean"]) for j, r in zip(jobs4, runs4, strict=True)},
         },
-        "slidernet_version": slidernet.__version__,
+        "slidernet_version": __version__,
         "files": sorted([*files, "summary.json"]),
     }
     summary_path = out / "summary.json"

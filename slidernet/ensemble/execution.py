@@ -159,7 +159,7 @@ def _advance_with_checkpoints(real, partial: Path | None, every: float, meta: di
     the realization is then saved (when it has a ``partial`` path) at the
     clean point where it stopped.
     """
-    from slidernet.checkpoint import save_realization
+    from slidernet.io.checkpoint import save_realization
 
     steps = real.scene.steps
     chunk = 1
@@ -224,7 +224,7 @@ def run_realization(config_json: str, seed: int, r: int, partial: str | None = N
     path = None if partial is None else Path(partial)
     meta = {**(meta or {}), "realization": r}
     if path is not None and path.exists():
-        from slidernet.checkpoint import load_realization
+        from slidernet.io.checkpoint import load_realization
 
         real = load_realization(scene, ss, path, expect_meta=meta)
     else:

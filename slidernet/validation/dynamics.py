@@ -111,7 +111,7 @@ class Dynamics:
     ----------
     scene : Scene
         A scene of a 1D network (``two_slider``, ``chain`` or any 1D
-        :class:`~slidernet.network.Network`), with its f_ext, normal loads,
+        :class:`~slidernet.model.network.Network`), with its f_ext, normal loads,
         thresholds law and driver.
     tau_ratio : float
         tau_dyn / tau_th, > 0, with tau_dyn = sqrt(m / k) the period of the

@@ -17,7 +17,7 @@ nor leak figures; a caller who passes its own Axes keeps its figure.
 
 Examples
 --------
->>> from slidernet.network import chain
+>>> from slidernet.model.network import chain
 >>> from matplotlib.figure import Figure
 >>> ax = Figure().subplots()
 >>> line = node_field(ax, chain(4, Ntilde=1e-7), [3, 0, 1, 2], log=True, label="slips")
@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.axes import Axes
 
-    from slidernet.network import Network
+    from slidernet.model.network import Network
 
 __all__ = ["EDGE_LIMIT", "mu_s_field", "network_of", "node_field", "save_network_pictures", "slip_map"]
 

@@ -281,7 +281,7 @@ def assemble(
     -------
     xarray.Dataset
         Coordinates ``realization`` and ``t``; see the module docstring.
-        :func:`slidernet.io.write_result_stream` writes the same variables,
+        :func:`slidernet.ensemble.stream.write_result_stream` writes the same variables,
         chunk by chunk, to a file.
     """
     stats = EnsembleStats(observables, int(t[-1]))

@@ -1,65 +1,27 @@
-"""Writing and reading result files (netCDF), atomically.
+"""The ensemble's result file, written chunk by chunk as realizations come in.
 
-A result is first written to a temporary file in the destination folder and
-then renamed over the target, so an interrupted run never leaves a partial
-``result.nc``.
+A run with an output directory streams its realizations to ``result.nc``:
+memory does not grow with the number of realizations, and the file is
+written atomically (a temporary file, then a rename).
 """
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
-from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
-
-@contextmanager
-def atomic_output(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path next to ``path``; on success rename it over ``path``.
-
-    On any exception (Ctrl-C included) the temporary file is removed and
-    ``path`` is left as it was. The file gets the usual permissions (mkstemp
-    alone would leave it private to its owner).
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        yield Path(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    # Reading the umask means setting it; put it straight back.
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename)."""
-    with atomic_output(path) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4")
-    return Path(path)
+from slidernet.io import atomic_output
 
 
 def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray, R: int,
                         observables: list[str], attrs: dict[str, str]) -> Path:
     """Write a result to netCDF chunk by chunk, atomically; memory does not grow with R.
 
-    The same variables and bits as :func:`slidernet.observables.assemble`
+    The same variables and bits as :func:`slidernet.analysis.observables.assemble`
     followed by :func:`write_netcdf`: the per-realization variables go to the
-    file one chunk of :data:`slidernet.observables.CHUNK` realizations at a
+    file one chunk of :data:`slidernet.analysis.observables.CHUNK` realizations at a
     time (stored in chunks of that many realizations), the ensemble
     statistics are reduced on the fly in the same chunks.
 
@@ -80,7 +42,7 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
     """
     import netCDF4
 
-    from slidernet.observables import CHUNK, EnsembleStats, chunks, coordinates, realization_variables
+    from slidernet.analysis.observables import CHUNK, EnsembleStats, chunks, coordinates, realization_variables
 
     def create(nc, name: str, dims: str | tuple[str, ...], data: np.ndarray, var_attrs: dict) -> netCDF4.Variable:
         dims = (dims,) if isinstance(dims, str) else tuple(dims)
@@ -122,22 +84,3 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
             create(nc, name, dims, data, var_attrs)[...] = data
         nc.setncatts(attrs)
     return path
-
-
-def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
-    """Save a matplotlib figure to ``path`` atomically (temporary file, then rename)."""
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **savefig_kwargs)
-    return path
-
-
-def read_result(path: str | Path) -> xr.Dataset:
-    """Load a result file fully into memory (the file is closed on return)."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        return ds.load()
-
-
-def result_config(ds: xr.Dataset) -> dict:
-    """The resolved configuration stored in a result's attributes."""
-    return json.loads(ds.attrs["config"])

@@ -2,8 +2,8 @@
 
 Two registries exist, one per entry-point group:
 
-* ``slidernet.distributions`` -- distributions of the static threshold mu_s;
-* ``slidernet.drivers`` -- temperature (thermal dilation theta) drivers.
+* ``slidernet.plugins.distributions`` -- distributions of the static threshold mu_s;
+* ``slidernet.plugins.drivers`` -- temperature (thermal dilation theta) drivers.
 
 A registry maps a name to a *factory*: ``factory(**params)`` returns the plugin
 object. The built-ins are always there; third-party packages add names through
@@ -19,9 +19,7 @@ from collections.abc import Callable
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
-import numpy as np
-
-from slidernet.errors import PluginError, UnknownPluginError
+from slidernet.errors import UnknownPluginError
 
 Factory = Callable[..., Any]
 
@@ -138,32 +136,14 @@ class Registry:
         self._errors.clear()
 
 
-def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str, call: str) -> np.ndarray:
-    """A plugin's returned array as float64, refused unless it has ``shape`` and is finite.
-
-    >>> checked_output([1.0, float("nan")], (2,), "driver", "mine", "thetas(rng, 1)")
-    Traceback (most recent call last):
-    ...
-    slidernet.errors.PluginError: The driver 'mine' returned NaN or inf values from thetas(rng, 1).
-    """
-    arr = np.asarray(values, dtype=np.float64)
-    if arr.shape != shape:
-        raise PluginError(
-            f"The {kind} {name!r} returned shape {arr.shape} from {call}; expected {shape}."
-        )
-    if not np.isfinite(arr).all():
-        raise PluginError(f"The {kind} {name!r} returned NaN or inf values from {call}.")
-    return arr
-
-
 def _builtin_distributions() -> dict[str, Factory]:
-    from slidernet.distributions import BUILTINS
+    from slidernet.plugins.distributions import BUILTINS
 
     return BUILTINS
 
 
 def _builtin_drivers() -> dict[str, Factory]:
-    from slidernet.drivers import BUILTINS
+    from slidernet.plugins.drivers import BUILTINS
 
     return BUILTINS
 

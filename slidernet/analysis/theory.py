@@ -208,7 +208,7 @@ def mu_max_cdf(dist: Any, mu: ArrayLike, n: ArrayLike) -> np.ndarray:
     ----------
     dist : object
         The distribution of mu_s as the model draws it, i.e. already
-        truncated below mu_d (e.g. :class:`~slidernet.distributions.TruncatedBelow`).
+        truncated below mu_d (e.g. :class:`~slidernet.plugins.distributions.TruncatedBelow`).
         Needs ``cdf``; ``sf`` is used when present, which keeps the result
         accurate in the upper tail for ``n`` up to 1e9 and beyond.
     mu : float or array_like
@@ -223,7 +223,7 @@ def mu_max_cdf(dist: Any, mu: ArrayLike, n: ArrayLike) -> np.ndarray:
 
     Examples
     --------
-    >>> from slidernet.distributions import Gaussian
+    >>> from slidernet.plugins.distributions import Gaussian
     >>> d = Gaussian(0.6, 0.01)
     >>> float(mu_max_cdf(d, 0.6, 0))
     0.25
@@ -340,7 +340,7 @@ def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
 
     Examples
     --------
-    >>> from slidernet.distributions import Gaussian, TruncatedBelow
+    >>> from slidernet.plugins.distributions import Gaussian, TruncatedBelow
     >>> d = TruncatedBelow(Gaussian(0.6, 0.01), lower=0.5, name="gaussian")
     >>> mean, std = mu_max_moments(d, [0, 1000])
     >>> mean.round(5).tolist(), std.round(5).tolist()

@@ -71,9 +71,9 @@ import numpy as np
 import xarray as xr
 from tqdm.auto import tqdm
 
-import slidernet
-from slidernet import runner
+from slidernet._version import __version__
 from slidernet.config import Config, load_config, read_toml
+from slidernet.ensemble import runner
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
 from slidernet.io import atomic_output, write_netcdf
 from slidernet.solver import Scene, record_times
@@ -375,7 +375,7 @@ def sweep(
         "config": json.dumps(base, sort_keys=True),
         "sweep": json.dumps(grid),
         "configs": json.dumps([json.loads(r.attrs["config"]) for r in results]),
-        "slidernet_version": slidernet.__version__,
+        "slidernet_version": __version__,
         "seed": str(seed),
         "kernel": results[0].attrs["kernel"],
         "Conventions": "CF-1.8",
@@ -393,7 +393,7 @@ _SWEEP_JSON = "sweep.json"
 
 def _identity(base: dict[str, Any], grid: dict[str, list[Any]]) -> dict[str, Any]:
     """What a sweep folder must match to be resumed (JSON-normalized: tuples are lists)."""
-    return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": slidernet.__version__}))
+    return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": __version__}))
 
 
 def _clear_folder(folder: Path) -> None:

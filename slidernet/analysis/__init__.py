@@ -1,0 +1,1 @@
+"""From records to answers: the result dataset and its statistics, the theory, pictures of networks."""

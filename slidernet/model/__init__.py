@@ -1,0 +1,1 @@
+"""The physical model: networks of sliders and springs, their builders, physical units."""

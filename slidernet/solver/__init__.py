@@ -1,0 +1,23 @@
+"""The quasi-static, event-driven solver: from a validated configuration to the records of a realization.
+
+- :mod:`~slidernet.solver.scene`: :class:`Scene`, everything derived once
+  from a configuration (network, operators, the kernel picked for it);
+- :mod:`~slidernet.solver.streams`: the random streams of a realization and
+  the order in which its draws are read;
+- :mod:`~slidernet.solver.realization`: :class:`Realization`, one
+  realization's state, advanced by the compiled kernels.
+"""
+
+from slidernet.solver.realization import Realization, simulate
+from slidernet.solver.scene import (
+    EVENT_CHUNK,
+    Scene,
+    build_network,
+    pair_tilt_applies,
+    record_times,
+    tilt_avalanche_cap,
+)
+from slidernet.solver.streams import draw_thetas, horizontal_draws, realization_streams
+
+__all__ = ["EVENT_CHUNK", "Realization", "Scene", "build_network", "draw_thetas", "horizontal_draws",
+           "pair_tilt_applies", "realization_streams", "record_times", "simulate", "tilt_avalanche_cap"]

@@ -1,0 +1,73 @@
+"""The package's layout is its data flow: each stage imports only the stages below it, and no cycle.
+
+Stages, from the bottom up (ARCHITECTURE.md draws the same map):
+
+0. ``errors``, ``_validation``, ``_version``: exceptions and shared input checks;
+1. ``kernels``: the compiled loops (numba), which import nothing else;
+2. ``model``: networks, their builders, physical units;
+3. ``plugins``: distributions of mu_s, drivers, their registry and contract;
+4. ``config``: the validated configuration;
+5. ``solver``: scene, random streams, realizations;
+6. ``io``: files, the checkpoint folder, checkpoints of a realization;
+7. ``analysis``: the result dataset and its statistics, theory, pictures;
+8. ``ensemble``: ``run``, execution, sweeps;
+9. ``paper``, ``validation``: the reproduction, and tools that check the solver;
+10. the package's front (``__init__``, ``cli``, ``testing``).
+
+Every import counts, deferred ones inside functions included.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import slidernet
+
+ROOT = Path(slidernet.__file__).parent
+RANK = {"errors": 0, "_validation": 0, "_version": 0, "kernels": 1, "model": 2, "plugins": 3, "config": 4,
+        "solver": 5, "io": 6, "analysis": 7, "ensemble": 8, "paper": 9, "validation": 9,
+        "__init__": 10, "__main__": 10, "cli": 10, "testing": 10}
+
+
+def _stage(module: str) -> str:
+    """The stage of ``slidernet.a.b``: its first component (the package itself is its front)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def _imports(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [a.name for a in node.names if a.name.split(".")[0] == "slidernet"]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "slidernet":
+            if node.module == "slidernet":  # from slidernet import x: x is a stage
+                found += [f"slidernet.{a.name}" for a in node.names]
+            else:
+                found.append(node.module)
+    return found
+
+
+MODULES = sorted(p for p in ROOT.rglob("*.py"))
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(ROOT.parent).with_suffix("")
+    return ".".join(rel.parts)
+
+
+@pytest.mark.parametrize("path", MODULES, ids=[_module_name(p) for p in MODULES])
+def test_imports_point_down(path):
+    me = _module_name(path)
+    mine = RANK[_stage(me)]
+    up = [m for m in _imports(path) if RANK.get(_stage(m), 10) > mine]
+    assert not up, f"{me} (stage {mine}) imports up the layers: {up}"
+
+
+def test_every_stage_is_ranked():
+    stages = {_stage(_module_name(p)) for p in MODULES}
+    assert stages <= set(RANK), stages - set(RANK)
