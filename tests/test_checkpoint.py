@@ -17,7 +17,7 @@ from slidernet.errors import CheckpointError
 from slidernet.io.checkpoint import checkpoint_info, load_realization, save_realization
 from slidernet.plugins import distributions
 from slidernet.solver import Realization, Scene, simulate
-from slidernet.solver import realization as realization_module
+from slidernet.solver import backends as backends_module
 
 from .conftest import make_config
 
@@ -57,7 +57,7 @@ pytestmark = pytest.mark.filterwarnings("ignore:The event catalogue reached solv
 @pytest.fixture(autouse=True)
 def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     # Catalogue chunks of 64 rows: several are handed to Python before the checkpoint.
-    monkeypatch.setattr(realization_module, "EVENT_CHUNK", 64)
+    monkeypatch.setattr(backends_module, "EVENT_CHUNK", 64)
     # Raw threshold chunks of 64 draws: the streams' Generators have moved past
     # their first chunk, and hold a surplus, at the checkpoint.
     monkeypatch.setattr(distributions, "RAW_CHUNK", 64)
@@ -103,7 +103,7 @@ def test_a_resumed_realization_gives_the_uninterrupted_bits(name: str, tmp_path:
         assert real.out["f_count"].sum() > 0
         assert real.rngs["tilt"].bit_generator.state != fresh.rngs["tilt"].bit_generator.state
     if real.scene.catalogue:
-        assert len(real._event_chunks) > 0 and real.ist[kernels.EV_POS] > 0
+        assert len(real.backend.event_chunks) > 0 and real.ist[kernels.EV_POS] > 0
 
     # New Python objects throughout: another Scene from the same config, another SeedSequence.
     scene = fresh_scene(name)
@@ -244,8 +244,13 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     header = json.loads(arrays["header"].tobytes())
     arrays["header"] = np.frombuffer(json.dumps({**header, "version": 99}).encode(), np.uint8)
     np.savez(tmp_path / "future.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 2"):
+    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 3"):
         load_realization(scene, ss, tmp_path / "future.npz")
+    # A checkpoint of the layout before the per-kernel backends (version 2) is refused, not misread.
+    arrays["header"] = np.frombuffer(json.dumps({**header, "version": 2}).encode(), np.uint8)
+    np.savez(tmp_path / "old.npz", **arrays)
+    with pytest.raises(CheckpointError, match=r"layout version 2; this slidernet reads version 3"):
+        load_realization(scene, ss, tmp_path / "old.npz")
     with pytest.raises(FileNotFoundError):
         load_realization(scene, ss, tmp_path / "missing.npz")
 

@@ -10,7 +10,7 @@ from slidernet.config import load_config
 from slidernet.model.builders import triangular
 from slidernet.model.network import Network, chain
 from slidernet.solver import Realization, Scene
-from slidernet.solver import realization as realization_module
+from slidernet.solver import backends as backends_module
 
 from .conftest import make_config
 
@@ -37,7 +37,7 @@ def catalogued_displacements(ev: dict, shape: tuple[int, ...]) -> np.ndarray:
 @pytest.fixture
 def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     # Many returns of the kernel to Python per run: exercises the buffer hand-over.
-    monkeypatch.setattr(realization_module, "EVENT_CHUNK", 64)
+    monkeypatch.setattr(backends_module, "EVENT_CHUNK", 64)
 
 
 @pytest.mark.parametrize("net", list(NETWORKS.values()), ids=list(NETWORKS))

@@ -55,7 +55,7 @@ def hard_config(network: dict[str, Any], ratio: float, Ntilde: float = 1e-7, ste
 
 def force_scale(r: Realization) -> float:
     """Size of the numbers that F = a + g theta (F = theta - u for the pair) is the difference of."""
-    state = abs(float(r.fst[kernels.U])) if r.scene.kernel == "pair" else float(np.abs(r.a).max())
+    state = abs(float(r.fst[kernels.U])) if r.scene.kernel == "pair" else float(np.abs(r.backend.a).max())
     return max(1.0, abs(float(r.fst[kernels.THETA])), state)
 
 
@@ -208,7 +208,7 @@ def test_networks_at_sigma_theta_1e4_stay_stable_and_finite(network, steps):
     assert r.n > 1_000_000
     for name in ("mu_max", "x_G", "mu_min", "mu_mean"):
         assert np.isfinite(res[name]).all(), name
-    assert np.isfinite(r.u).all() and np.isfinite(r.a).all()
+    assert np.isfinite(r.backend.u).all() and np.isfinite(r.backend.a).all()
 
 
 # --------------------------------------------------------------------------
@@ -444,7 +444,7 @@ def relaxation_order(network: dict[str, Any], bumps: dict[int, float],
     cfg = hard_config(network, 1.0, steps=1, observables=["n", "events"])
     cfg["friction"]["static"] = threshold_file
     r = realization_of(cfg, 0)
-    u = r.u.reshape(r.mu.size, -1)
+    u = r.backend.u.reshape(r.mu.size, -1)
     for node, b in bumps.items():
         u[node, 0] = b
     r.recompute_forces()

@@ -109,7 +109,7 @@ def slip_by_slip(real: Realization):
         real.mu_buf = np.array(queue[:1])
         ist[kernels.MU_POS] = 0
         before = (real.thresholds, fst[kernels.U], fst[kernels.XG], int(ist[kernels.N_EVENTS]))
-        status = real._call_kernel(real.thetas)
+        status = real.backend.run(real, real.thetas)
         assert status == kernels.DONE or ist[kernels.MU_POS] == 1  # else no progress
         if ist[kernels.MU_POS] == 1:
             queue.pop(0)

@@ -19,22 +19,24 @@ File layout (keys of the ``.npz``; every array numeric):
     digests of K, g, the loads and the recorded times), ``thetas`` (a digest
     of theta(t_q)), ``rngs`` (the ``bit_generator.state`` of the driver,
     thresholds, tilt and tilt_uniforms streams), ``step`` and ``n`` (for information),
-    ``tilted``, ``events_complete``, ``ev_rows`` and ``numpy``.
+    ``tilted`` and ``numpy``.
 ``state/<name>``
-    The arrays of the realization: ``ist``, ``fst``, ``mu``, ``mu_buf``,
-    ``tmu``, ``tu``, and for the network kernels ``a``, ``u``, ``hp``,
-    ``hpos``, ``hv``, ``aval_hist``, ``node_slips``.
+    The arrays every realization has: ``ist``, ``fst``, ``mu``, ``mu_buf``,
+    ``tmu``, ``tu``.
 ``surplus/<name>``
     float64, the surplus of the ``thresholds`` and ``tilt`` threshold
     streams (``Realization.draws``), in order (version 2 on).
 ``out/<name>``
     The records written so far (every key of ``Realization.out``).
-``events/buffer_i``, ``events/buffer_f``
-    Network kernels: the catalogue rows in the kernel's buffer (its first
-    ``ist[EV_POS]`` rows).
-``events/chunks_i``, ``events/chunks_f``, ``events/chunk_rows``
-    Network kernels: the chunks already handed to Python, concatenated, and
-    the number of rows of each.
+``backend/<name>``
+    The kernel's own state, as its backend writes and reads it
+    (:mod:`slidernet.solver.backends`, version 3 on): nothing for the pair
+    kernel; for the network kernels ``a``, ``u``, ``hp``, ``hpos``, ``hv``,
+    ``aval_hist``, ``node_slips``, the catalogue rows in the kernel's buffer
+    (``events/buffer_i``, ``events/buffer_f``: its first ``ist[EV_POS]``
+    rows; ``events/buffer_rows``, its size), the chunks already handed to
+    Python (``events/chunks_i``, ``events/chunks_f``, ``events/chunk_rows``)
+    and ``events/complete``.
 """
 
 from __future__ import annotations
@@ -48,23 +50,21 @@ from typing import Any
 
 import numpy as np
 
-from slidernet import kernels
 from slidernet.errors import CheckpointError
 from slidernet.io import atomic_output
 from slidernet.solver import Realization, Scene
 
 FORMAT = "slidernet-checkpoint"
 # 2: the threshold streams' surplus (surplus/<name>) and the tilt_uniforms stream.
-VERSION = 2
+# 3: the kernel's own state under backend/<name>, written and read by its backend.
+VERSION = 3
 
 # Arrays whose shape and dtype are fixed by the scene: copied into the fresh realization's own.
 _FIXED = ("ist", "fst", "mu")
-_FIXED_NETWORK = ("a", "u", "hp", "hpos", "hv", "aval_hist", "node_slips")
 # Draw buffers: their length changes when they are refilled.
 _BUFFERS = ("mu_buf", "tmu", "tu")
 # Attributes written to the file by name (arrays above, or special handling below).
-_SAVED = {*_FIXED, *_FIXED_NETWORK, *_BUFFERS, "out", "rngs", "draws", "ev_i", "ev_f", "_event_chunks",
-          "events_complete", "_tilted"}
+_SAVED = {*_FIXED, *_BUFFERS, "out", "rngs", "draws", "backend", "_tilted"}
 # Attributes the constructor rebuilds, and why that is exact.
 _REBUILT = {
     "scene": "passed to load_realization",
@@ -127,7 +127,6 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
             f"The realization holds {unknown} that slidernet.io.checkpoint neither saves nor rebuilds; "
             "add each to checkpoint._SAVED (and save it) or to checkpoint._REBUILT."
         )
-    network = real.scene.kernel != "pair"
     header: dict[str, Any] = {
         "format": FORMAT,
         "version": VERSION,
@@ -138,8 +137,6 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
         "step": real.step,
         "n": real.n,
         "tilted": int(real._tilted),
-        "events_complete": bool(real.events_complete) if network else True,
-        "ev_rows": int(real.ev_i.shape[0]) if network else 0,
         "numpy": np.__version__,
     }
     try:
@@ -147,21 +144,14 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
     except (TypeError, ValueError) as exc:
         raise CheckpointError(f"The checkpoint meta must be JSON-serializable: {exc}.") from None
     arrays = {"header": np.frombuffer(text.encode("utf-8"), dtype=np.uint8)}
-    for name in _FIXED + _BUFFERS + (_FIXED_NETWORK if network else ()):
+    for name in _FIXED + _BUFFERS:
         arrays[f"state/{name}"] = getattr(real, name)
+    for name, values in real.backend.to_arrays(real).items():
+        arrays[f"backend/{name}"] = np.asarray(values)
     for name, stream in real.draws.items():
         arrays[f"surplus/{name}"] = stream.surplus
     for name, values in real.out.items():
         arrays[f"out/{name}"] = values
-    if network:
-        k = int(real.ist[kernels.EV_POS])
-        # Rows past EV_POS are stale: the kernel writes a row before anything reads it.
-        arrays["events/buffer_i"] = real.ev_i[:k]
-        arrays["events/buffer_f"] = real.ev_f[:k]
-        chunks = real._event_chunks
-        arrays["events/chunk_rows"] = np.array([c[0].shape[0] for c in chunks], dtype=np.int64)
-        arrays["events/chunks_i"] = np.concatenate([np.zeros((0, 2), np.int64)] + [c[0] for c in chunks])
-        arrays["events/chunks_f"] = np.concatenate([np.zeros((0, 3))] + [c[1] for c in chunks])
     odd = sorted(key for key, a in arrays.items() if a.dtype.kind not in "biuf")
     if odd:  # np.savez would pickle them, and load_realization refuses pickles
         raise CheckpointError(f"The checkpoint arrays {odd} are not numeric.")
@@ -354,9 +344,8 @@ def _take(arrays: dict[str, np.ndarray], key: str, like: np.ndarray | None = Non
 
 def _restore(real: Realization, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
     """Overwrite the state of a freshly constructed ``real`` (same scene and seed) from a checkpoint."""
-    network = real.scene.kernel != "pair"
     # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
-    for name in _FIXED + (_FIXED_NETWORK if network else ()):
+    for name in _FIXED:
         target = getattr(real, name)
         target[...] = _take(arrays, f"state/{name}", target)
     for name in _BUFFERS:
@@ -366,24 +355,8 @@ def _restore(real: Realization, header: dict[str, Any], arrays: dict[str, np.nda
         raise ValueError(f"its records are {sorted(saved_out)}, this scene's are {sorted(real.out)}")
     for name, target in real.out.items():
         target[...] = _take(arrays, f"out/{name}", target)
-    if network:
-        k, rows = int(real.ist[kernels.EV_POS]), int(header["ev_rows"])
-        if not 0 <= k <= rows:
-            raise ValueError(f"{k} catalogue rows are written in a buffer of {rows}")
-        real.ev_i = np.zeros((rows, 2), np.int64)
-        real.ev_f = np.zeros((rows, 3))
-        real.ev_i[:k] = _take(arrays, "events/buffer_i", real.ev_i[:k])
-        real.ev_f[:k] = _take(arrays, "events/buffer_f", real.ev_f[:k])
-        counts = _take(arrays, "events/chunk_rows", dtype=np.int64, ndim=1)
-        ev_i = _take(arrays, "events/chunks_i", dtype=np.int64, ndim=2)
-        ev_f = _take(arrays, "events/chunks_f", dtype=np.float64, ndim=2)
-        total = int(counts.sum())
-        if (counts < 0).any() or ev_i.shape != (total, 2) or ev_f.shape != (total, 3):
-            raise ValueError(f"the catalogue chunks of {counts.tolist()} rows are {ev_i.shape} and {ev_f.shape}")
-        cuts = np.cumsum(counts)[:-1]
-        real._event_chunks = [(i.copy(), f.copy()) for i, f in zip(np.split(ev_i, cuts), np.split(ev_f, cuts),
-                                                                     strict=True)] if counts.size else []
-        real.events_complete = bool(header["events_complete"])
+    own = {key.removeprefix("backend/"): a for key, a in arrays.items() if key.startswith("backend/")}
+    real.backend.from_arrays(real, own, _take)
     real._tilted = int(header["tilted"])
     if set(header["rngs"]) != set(real.rngs):
         raise ValueError(f"its streams are {sorted(header['rngs'])}, a realization's are {sorted(real.rngs)}")

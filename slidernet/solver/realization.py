@@ -13,14 +13,13 @@ one rearrangement to the next by solving eq. `critique` exactly.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from slidernet import kernels
 from slidernet.errors import AvalancheError, TiltTestError
 from slidernet.plugins.distributions import TruncatedStream
-from slidernet.solver.scene import EVENT_CHUNK, Scene, tilt_avalanche_cap
+from slidernet.solver.backends import backend_for
+from slidernet.solver.scene import Scene, tilt_avalanche_cap
 from slidernet.solver.streams import _refill, horizontal_draws, realization_streams
 
 
@@ -95,47 +94,9 @@ class Realization:
         self.fst[kernels.U] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
         self.fst[kernels.MU_MAX] = self.mu.max()
         self.ist[kernels.ARGMAX] = int(np.argmax(self.mu))
-        if scene.kernel != "pair":
-            self._init_network_state()
-
-    def _init_network_state(self) -> None:
-        N = self.scene.network.n_nodes
-        g = self.scene.ops["g"]
-        # a = F - theta g with u = 0: every spring at rest at theta(0), plus the external load.
-        self.a = -g * self.thetas[0] + self._f_ext()
-        self.u = np.zeros_like(g)
-        self.hp = np.zeros((3, N), np.int64)
-        self.hpos = np.full((N, 3), -1, np.int64)
-        self.hv = np.zeros((3, N))
-        self.aval_hist = np.zeros(kernels.N_AVALANCHE_BINS, np.int64)
-        self.node_slips = np.zeros(N, np.int64)
-        T = self.scene.rec_times.size
-        self.out.update(mu_mean=np.zeros(T), mu_min=np.zeros(T))
-        if self.scene.kernel == "vec":
-            self.out.update(y_G=np.zeros(T))
-        # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows,
-        # Python keeps the full ones (at most max_events rows in all).
-        rows = EVENT_CHUNK if self.scene.catalogue else 0
-        self.ev_i = np.zeros((rows, 2), np.int64)
-        self.ev_f = np.zeros((rows, 3))
-        self._event_chunks: list[tuple[np.ndarray, np.ndarray]] = []
-        self.events_complete = True
-        self.ist[kernels.EV_ON] = int(self.scene.catalogue)
-        self._rebuild_heaps()
-
-    def _rebuild_heaps(self) -> None:
-        o = self.scene.ops
-        if self.scene.kernel == "vec":
-            kernels.init_vec_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp,
-                                   self.hv, self.hpos, self.ist, self.fst)
-        else:
-            kernels.init_csr_heaps(self.a, o["g"], self.mu, o["normal_load"], self.hp, self.hv,
-                                   self.hpos, self.ist, self.fst)
-
-    def _f_ext(self) -> np.ndarray:
-        """The external forces in the shape of ``a``: (N,) in 1D, (N, 2) in 2D."""
-        f_ext = self.scene.network.f_ext
-        return f_ext[:, 0].copy() if self.scene.network.dim == 1 else f_ext.copy()
+        # The kernel's own state; the backend is the only part that knows which kernel runs.
+        self.backend = backend_for(scene, self)
+        self.out.update(self.backend.records(T))
 
     def recompute_forces(self) -> float:
         """Recompute a = -K u - g theta(0) + f_ext from the displacements (sparse mat-vec).
@@ -150,16 +111,7 @@ class Realization:
         float
             The largest change of a force, in N (the drift that had accumulated).
         """
-        if self.scene.kernel == "pair":
-            return 0.0
-        g = self.scene.ops["g"]
-        fresh = (-(self.scene.K @ self.u.reshape(-1)) - g.reshape(-1) * self.thetas[0]).reshape(g.shape)
-        fresh += self._f_ext()
-        drift = float(np.abs(fresh - self.a).max())
-        self.a[...] = fresh
-        self.ist[kernels.SINCE_RECOMPUTE] = 0
-        self._rebuild_heaps()
-        return drift
+        return self.backend.recompute(self)
 
     @property
     def step(self) -> int:
@@ -188,46 +140,11 @@ class Realization:
 
     def forces(self) -> np.ndarray:
         """Spring forces on every node, in units of N, shape (N,) in 1D or (N, 2) in 2D."""
-        theta = self.fst[kernels.THETA]
-        if self.scene.kernel == "pair":
-            F = theta - self.fst[kernels.U]
-            return np.array([-F, F])
-        return self.a + self.scene.ops["g"] * theta
+        return self.backend.forces(self)
 
     def displacements(self) -> np.ndarray:
         """Displacements u of the nodes from their reference positions, in l0, shape (N, d)."""
-        Ntilde = self.scene.network.Ntilde
-        if self.scene.kernel == "pair":
-            # Slider 1 and 2 about the centre of mass; u = theta(0) at rest.
-            half = 0.5 * (self.fst[kernels.U] - self.thetas[0])
-            xg = self.fst[kernels.XG]
-            return Ntilde * np.array([[xg - half], [xg + half]])
-        return Ntilde * self.u.reshape(self.scene.network.n_nodes, -1)
-
-    def _call_kernel(self, thetas: np.ndarray) -> int:
-        sc, o, out = self.scene, self.scene.ops, self.out
-        if sc.kernel == "pair":
-            return kernels.run_pair(
-                thetas, sc.rec_times, self.mu, self.ist, self.fst, self.mu_buf, self.tmu,
-                self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, out["n"], out["mu_max"],
-                out["x_G"], out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
-            )
-        if sc.kernel == "csr":
-            return kernels.run_csr(
-                thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
-                self.tmu, self.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, sc.recompute_every,
-                o["indptr"], o["indices"], o["kdata"], o["kdiag"], o["g"], o["normal_load"],
-                o["w"], self.hp, self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i,
-                self.ev_f, out["n"], out["mu_max"], out["x_G"], out["n_records"], out["mu_mean"],
-                out["mu_min"], out["f_sum"], out["f_sq"], out["f_count"],
-            )
-        return kernels.run_vec(
-            thetas, sc.rec_times, self.mu, self.ist, self.fst, self.a, self.u, self.mu_buf,
-            sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
-            o["indices"], o["kblk"], o["diagpos"], o["g"], o["normal_load"], o["unit_load"], o["w"], self.hp,
-            self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i, self.ev_f, out["n"], out["mu_max"],
-            out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
-        )
+        return self.scene.network.Ntilde * self.backend.displacements(self)
 
     def advance(self, to_step: int | None = None) -> Realization:
         """Run the thermal steps up to ``to_step`` (default: the last one).
@@ -323,7 +240,7 @@ class Realization:
             return next(self._mu_batches)  # size is always sc.batch
 
         while True:
-            status = self._call_kernel(thetas)
+            status = self.backend.run(self, thetas)
             if status == kernels.DONE:
                 return self
             if status == kernels.NEED_MU:
@@ -334,7 +251,7 @@ class Realization:
             elif status == kernels.RECOMPUTE:
                 self.recompute_forces()
             elif status == kernels.NEED_EVENTS:
-                self._flush_events()
+                self.backend.flush_events(self)
             elif status == kernels.AVALANCHE_LIMIT:
                 i = int(ist[kernels.ERR_NODE])
                 force = np.round(np.atleast_1d(self.forces()[i]), 12).tolist()
@@ -356,25 +273,6 @@ class Realization:
             else:  # pragma: no cover - a new status code without a handler is a bug
                 raise RuntimeError(f"unknown kernel status {status}")
 
-    def _flush_events(self) -> None:
-        """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``."""
-        k = int(self.ist[kernels.EV_POS])
-        self._event_chunks.append((self.ev_i[:k].copy(), self.ev_f[:k].copy()))
-        self.ist[kernels.EV_POS] = 0
-        kept = sum(c[0].shape[0] for c in self._event_chunks)
-        room = self.scene.max_events - kept
-        if room < self.ev_i.shape[0]:
-            self.ev_i = self.ev_i[:room]
-            self.ev_f = self.ev_f[:room]
-        if room == 0:
-            self.ist[kernels.EV_ON] = 0
-            self.events_complete = False
-            warnings.warn(
-                f"The event catalogue reached solver.max_events = {self.scene.max_events} events at step "
-                f"{self.step}; later slips are not catalogued (the run goes on).",
-                RuntimeWarning, stacklevel=4,
-            )
-
     def events(self) -> dict[str, np.ndarray]:
         """The event catalogue so far: one row per slip, in the order of the slips.
 
@@ -387,13 +285,7 @@ class Realization:
             overload at t = 0), ``dx`` and ``dy`` (the node's displacement, in
             l0; ``dy`` is 0 in 1D).
         """
-        k = int(self.ist[kernels.EV_POS])
-        chunks = [*self._event_chunks, (self.ev_i[:k], self.ev_f[:k])]
-        ev_i = np.concatenate([c[0] for c in chunks])
-        ev_f = np.concatenate([c[1] for c in chunks])
-        Ntilde = self.scene.network.Ntilde
-        return {"time": ev_f[:, 0].copy(), "node": ev_i[:, 0].copy(), "avalanche": ev_i[:, 1].copy(),
-                "dx": ev_f[:, 1] * Ntilde, "dy": ev_f[:, 2] * Ntilde}
+        return self.backend.events(self)
 
     def result(self) -> dict[str, np.ndarray]:
         """The records at ``scene.rec_times`` (x_G converted to l0).
@@ -411,13 +303,7 @@ class Realization:
         if "y_G" in res:
             res["y_G"] *= Ntilde
         res["n_events"] = np.int64(self.ist[kernels.N_EVENTS])
-        if self.scene.kernel != "pair":
-            res["avalanche_count"] = self.aval_hist.copy()
-            res["node_slips"] = self.node_slips.copy()
-            res["mu_s"] = self.mu.copy()
-        if self.scene.catalogue:
-            res["events"] = self.events()
-            res["events_complete"] = self.events_complete
+        res.update(self.backend.result(self))
         return res
 
 
