@@ -11,10 +11,14 @@ from __future__ import annotations
 
 from slidernet.kernels.heap import (
     avalanche_done,
+    buffers_low,
     close_t0,
+    end_step,
     heap_set,
     log_event,
     mu_stats,
+    next_driving_event,
+    open_driving_event,
     open_initial_relaxation,
     redraw_threshold,
 )
@@ -24,15 +28,8 @@ from slidernet.kernels.state import (
     DONE,
     DOWN_SIZE,
     ERR_NODE,
-    EV_ON,
-    EV_POS,
-    EV_T,
     HEAP_SIZE,
     IN_AVALANCHE,
-    MU_POS,
-    N_EVENTS,
-    NEED_EVENTS,
-    NEED_MU,
     REC,
     RECOMPUTE,
     SINCE_RECOMPUTE,
@@ -134,12 +131,10 @@ def run_csr(
                 return AVALANCHE_LIMIT
             # The buffer check comes first: a kernel that returns after the
             # tilt sample would take it again on re-entry.
-            if ist[MU_POS] >= mu_buf.size:
+            st = buffers_low(ist, mu_buf, ev_i)
+            if st != DONE:
                 ist[AV_SLIPS] -= 1
-                return NEED_MU
-            if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
-                ist[AV_SLIPS] -= 1
-                return NEED_EVENTS
+                return st
             if do_tilt:
                 st = tilt_sample(a[1] + g[1] * theta, mu[0], mu[1], mu_d, tmu, tu, ist,
                                  ist[REC], fsum, fsq, fcount)
@@ -161,45 +156,26 @@ def run_csr(
                 _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
-        q = ist[Q]
-        if q >= steps:
+        if ist[Q] >= steps:
             return DONE
-        theta_b = thetas[q + 1]
-        s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
-        best = -1
-        if s > 0.0 and ist[UP_SIZE] > 0:
-            best = hp[1, 0]
-            thc = -hv[1, 0]
-        elif s < 0.0 and ist[DOWN_SIZE] > 0:
-            best = hp[2, 0]
-            thc = hv[2, 0]
+        best, thc, s = next_driving_event(thetas, ist, fst, hp, hv)
         if best >= 0:
-            theta = fst[THETA]
-            if s * (thc - theta) < 0.0:
-                thc = theta  # rounding: the node is already at its threshold
-            if s * (theta_b - thc) >= 0.0:
-                fst[THETA] = thc
-                if ist[MU_POS] >= mu_buf.size:
-                    return NEED_MU
-                if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
-                    return NEED_EVENTS
-                if do_tilt:
-                    st = tilt_sample(a[1] + g[1] * thc, mu[0], mu[1], mu_d, tmu, tu, ist,
-                                     ist[REC], fsum, fsq, fcount)
-                    if st != DONE:
-                        return st
-                # At theta_c the force on the node is exactly +-mu_s N, with the
-                # sign of g s (the direction its force moves).
-                lim = mu[best] * normal_load[best]
-                sigma = 1.0 if g[best] * s > 0.0 else -1.0
-                ist[AV_SLIPS] = 0
-                ist[IN_AVALANCHE] = 1
-                ist[N_EVENTS] += 1
-                fst[EV_T] = q + (thc - thetas[q]) / (theta_b - thetas[q])
-                _slip(best, sigma * lim, lim, a, u, mu, indptr, indices, kdata, kdiag, g,
-                      normal_load, w, ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f)
-                continue
-        ist[Q] = q + 1
-        fst[THETA] = theta_b
-        if ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1:
+            fst[THETA] = thc
+            st = buffers_low(ist, mu_buf, ev_i)
+            if st != DONE:
+                return st
+            if do_tilt:
+                st = tilt_sample(a[1] + g[1] * thc, mu[0], mu[1], mu_d, tmu, tu, ist,
+                                 ist[REC], fsum, fsq, fcount)
+                if st != DONE:
+                    return st
+            # At theta_c the force on the node is exactly +-mu_s N, with the
+            # sign of g s (the direction its force moves).
+            lim = mu[best] * normal_load[best]
+            sigma = 1.0 if g[best] * s > 0.0 else -1.0
+            open_driving_event(thetas, thc, ist, fst)
+            _slip(best, sigma * lim, lim, a, u, mu, indptr, indices, kdata, kdiag, g,
+                  normal_load, w, ist, fst, mu_buf, mu_d, hp, hv, hpos, node_slips, ev_i, ev_f)
+            continue
+        if end_step(thetas, rec_times, ist, fst):
             _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_records, out_mu_mean, out_mu_min)

@@ -27,6 +27,9 @@ from __future__ import annotations
 from slidernet.kernels.state import (
     ARGMAX,
     AV_SLIPS,
+    DONE,
+    DOWN_SIZE,
+    EV_ON,
     EV_POS,
     EV_T,
     HEAP_SIZE,
@@ -36,9 +39,14 @@ from slidernet.kernels.state import (
     N_EVENTS,
     N_RECORDS,
     N_SLIPS,
+    NEED_EVENTS,
+    NEED_MU,
     REC,
     SINCE_RECOMPUTE,
     STARTED,
+    THETA,
+    UP_SIZE,
+    Q,
     kernel_jit,
 )
 
@@ -229,3 +237,64 @@ def mu_stats(mu):
         total += mu[j]
         low = min(low, mu[j])
     return total / mu.size, low
+
+
+@kernel_jit(inline="always")
+def buffers_low(ist, mu_buf, ev_i):
+    """Why a slip cannot happen now: ``NEED_MU`` (no threshold left to redraw), ``NEED_EVENTS``
+    (the catalogue's buffer is full), or ``DONE`` (it can). Checked before every slip, so that a
+    kernel returns only at clean points."""
+    if ist[MU_POS] >= mu_buf.size:
+        return NEED_MU
+    if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
+        return NEED_EVENTS
+    return DONE
+
+
+@kernel_jit(inline="always")
+def next_driving_event(thetas, ist, fst, hp, hv):
+    """The next node to reach its threshold as theta moves linearly from thetas[q] to thetas[q + 1].
+
+    Reads the two driving heaps (upper critical thetas when theta rises,
+    lower ones when it falls; eq. `critique` for each node). Returns
+    ``(node, theta_c, s)``: node -1 if none is reached within the segment
+    (inclusive at its end); theta_c is clamped to the current theta where
+    rounding put it behind; s is the sign of d(theta)/dt.
+    """
+    q = ist[Q]
+    theta_b = thetas[q + 1]
+    s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
+    best = -1
+    thc = 0.0
+    if s > 0.0 and ist[UP_SIZE] > 0:
+        best = hp[1, 0]
+        thc = -hv[1, 0]
+    elif s < 0.0 and ist[DOWN_SIZE] > 0:
+        best = hp[2, 0]
+        thc = hv[2, 0]
+    if best >= 0:
+        theta = fst[THETA]
+        if s * (thc - theta) < 0.0:
+            thc = theta  # rounding: the node is already at its threshold
+        if s * (theta_b - thc) < 0.0:
+            best = -1
+    return best, thc, s
+
+
+@kernel_jit(inline="always")
+def open_driving_event(thetas, thc, ist, fst):
+    """Start the avalanche of a driving event at theta_c: count it, and stamp its time (q + fraction)."""
+    q = ist[Q]
+    ist[AV_SLIPS] = 0
+    ist[IN_AVALANCHE] = 1
+    ist[N_EVENTS] += 1
+    fst[EV_T] = q + (thc - thetas[q]) / (thetas[q + 1] - thetas[q])
+
+
+@kernel_jit(inline="always")
+def end_step(thetas, rec_times, ist, fst):
+    """No node reaches its threshold before thetas[q + 1]: go there; True if that time is recorded."""
+    q = ist[Q]
+    ist[Q] = q + 1
+    fst[THETA] = thetas[q + 1]
+    return ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1

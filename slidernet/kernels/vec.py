@@ -24,10 +24,14 @@ import math
 
 from slidernet.kernels.heap import (
     avalanche_done,
+    buffers_low,
     close_t0,
+    end_step,
     heap_set,
     log_event,
     mu_stats,
+    next_driving_event,
+    open_driving_event,
     open_initial_relaxation,
     redraw_threshold,
 )
@@ -37,18 +41,11 @@ from slidernet.kernels.state import (
     DONE,
     DOWN_SIZE,
     ERR_NODE,
-    EV_ON,
-    EV_POS,
-    EV_T,
     HEAP_SIZE,
     IN_AVALANCHE,
     MU_MAX,
-    MU_POS,
-    N_EVENTS,
     N_RECORDS,
     N_SLIPS,
-    NEED_EVENTS,
-    NEED_MU,
     REC,
     RECOMPUTE,
     SINCE_RECOMPUTE,
@@ -332,12 +329,10 @@ def run_vec(
             if ist[AV_SLIPS] > max_slips:
                 ist[ERR_NODE] = i
                 return AVALANCHE_LIMIT
-            if ist[MU_POS] >= mu_buf.size:
+            st = buffers_low(ist, mu_buf, ev_i)
+            if st != DONE:
                 ist[AV_SLIPS] -= 1
-                return NEED_MU
-            if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
-                ist[AV_SLIPS] -= 1
-                return NEED_EVENTS
+                return st
             absF = math.sqrt(Fx * Fx + Fy * Fy)
             if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load,
                          w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
@@ -350,44 +345,25 @@ def run_vec(
                     out_mu_mean, out_mu_min)
         if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
             return RECOMPUTE
-        q = ist[Q]
-        if q >= steps:
+        if ist[Q] >= steps:
             return DONE
-        theta_b = thetas[q + 1]
-        s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
-        best = -1
-        if s > 0.0 and ist[UP_SIZE] > 0:
-            best = hp[1, 0]
-            thc = -hv[1, 0]
-        elif s < 0.0 and ist[DOWN_SIZE] > 0:
-            best = hp[2, 0]
-            thc = hv[2, 0]
+        best, thc, _ = next_driving_event(thetas, ist, fst, hp, hv)
         if best >= 0:
-            theta = fst[THETA]
-            if s * (thc - theta) < 0.0:
-                thc = theta
-            if s * (theta_b - thc) >= 0.0:
-                fst[THETA] = thc
-                if ist[MU_POS] >= mu_buf.size:
-                    return NEED_MU
-                if ist[EV_ON] and ist[EV_POS] >= ev_i.shape[0]:
-                    return NEED_EVENTS
-                # At theta_c, |F| = mu_s N exactly; its direction is computed.
-                lim = mu[best] * normal_load[best]
-                Fx = a[best, 0] + g[best, 0] * thc
-                Fy = a[best, 1] + g[best, 1] * thc
-                ist[AV_SLIPS] = 0
-                ist[IN_AVALANCHE] = 1
-                ist[N_EVENTS] += 1
-                fst[EV_T] = q + (thc - thetas[q]) / (theta_b - thetas[q])
-                if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g,
-                             normal_load, unit_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
-                             node_slips, ev_i, ev_f):
-                    ist[ERR_NODE] = best
-                    return AVALANCHE_LIMIT
-                continue
-        ist[Q] = q + 1
-        fst[THETA] = theta_b
-        if ist[REC] < rec_times.size and rec_times[ist[REC]] == q + 1:
+            fst[THETA] = thc
+            st = buffers_low(ist, mu_buf, ev_i)
+            if st != DONE:
+                return st
+            # At theta_c, |F| = mu_s N exactly; its direction is computed.
+            lim = mu[best] * normal_load[best]
+            Fx = a[best, 0] + g[best, 0] * thc
+            Fy = a[best, 1] + g[best, 1] * thc
+            open_driving_event(thetas, thc, ist, fst)
+            if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g,
+                         normal_load, unit_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
+                         node_slips, ev_i, ev_f):
+                ist[ERR_NODE] = best
+                return AVALANCHE_LIMIT
+            continue
+        if end_step(thetas, rec_times, ist, fst):
             _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean,
                     out_mu_min)
