@@ -7,6 +7,7 @@ hold for most seeds too.
 
 from __future__ import annotations
 
+import inspect
 import math
 from pathlib import Path
 from typing import Any
@@ -130,6 +131,52 @@ def test_every_builtin_loads_through_a_config(case, data_file):
     assert truncated == ("above" not in case), d.dist.support()
     assert (d.mass < 1.0) == truncated
     assert MIN_MASS <= d.mass <= 1.0
+
+
+@pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
+def test_the_law_slidernet_draws_from_is_a_distribution(case, data_file):
+    # The raw built-in and the law the solver draws from (the registry's
+    # factory, truncated at mu_d by load_config) are one type, with one
+    # mean_max(m): the mean of the max of m draws of that very law.
+    raw, used = raw_law(case, data_file), used_law(case, data_file)
+    assert isinstance(raw, Distribution) and isinstance(used, Distribution)
+    assert list(inspect.signature(raw.mean_max).parameters) == ["m"]
+    assert inspect.signature(used.mean_max) == inspect.signature(raw.mean_max)
+    if "above" in case:
+        # No truncation happens: the same law, so the same numbers, bit for bit.
+        assert raw.support()[0] >= MU_D and used.support() == raw.support()
+        np.testing.assert_array_equal(used.mean_max(M_VALUES), raw.mean_max(M_VALUES), strict=True)
+    else:
+        # Truncation happens: the raw law's maximum is smaller, since it also
+        # counts the draws at or below mu_d.
+        assert raw.support()[0] < MU_D and used.support()[0] == MU_D
+        assert (raw.mean_max(M_VALUES[:3]) < used.mean_max(M_VALUES[:3])).all()
+    np.testing.assert_array_equal(used.mean_max(M_VALUES), raw.mean_max_above(M_VALUES, MU_D), strict=True)
+
+
+def test_mean_max_has_one_signature():
+    # Every built-in and the truncated law: mean_max(self, m); the truncation
+    # point goes to mean_max_above(self, m, lower) only.
+    for cls in (*BUILTINS.values(), TruncatedBelow, Distribution):
+        assert list(inspect.signature(cls.mean_max).parameters) == ["self", "m"], cls
+        assert list(inspect.signature(cls.mean_max_above).parameters) == ["self", "m", "lower"], cls
+    # A third-party plugin (sample and cdf only) becomes a Distribution too.
+    assert isinstance(TruncatedBelow(CdfOnlyUniform(), MU_D, "cdf_only"), Distribution)
+
+
+def test_truncated_law_support_and_check_mu_d():
+    # The rest of the Distribution interface on the truncated law: its support
+    # starts at mu_d, and check_mu_d lets the plugin name its own parameter.
+    plugin = TruncatedBelow(CdfOnlyUniform(), MU_D, "cdf_only")
+    assert plugin.support() == (MU_D, math.inf)  # the plugin does not give its upper end
+    plugin.check_mu_d(0.6)
+    with pytest.raises(ConfigError, match=r"'cdf_only', conditioned on mu_s > 0\.5, puts probability .* "
+                                          r"above mu_d = 0\.6499; at least 0\.001 is needed"):
+        plugin.check_mu_d(0.6499)
+    gaussian = TruncatedBelow(Gaussian(0.6, 0.01), MU_D, "gaussian")
+    assert gaussian.support() == (MU_D, math.inf)
+    with pytest.raises(ConfigError, match=r"The 'mean' parameter of gaussian must be > mu_d = 0\.7"):
+        gaussian.check_mu_d(0.7)
 
 
 def test_scipy_through_a_toml_file(tmp_path):
@@ -409,20 +456,22 @@ CLOSED_FORMS = {
 }
 
 
-@pytest.mark.parametrize("lower", [None, 0.4, 0.5], ids=["untruncated", "below-support", "truncated"])
+@pytest.mark.parametrize("lower", [-math.inf, 0.4, 0.5], ids=["untruncated", "below-support", "truncated"])
 @pytest.mark.parametrize("case", list(CLOSED_FORMS), ids=list(CLOSED_FORMS))
 def test_closed_forms_match_the_generic_quadrature(case, lower):
-    # The base class's mean_max is the tanh-sinh quadrature of the quantile
+    # The base class's mean_max_above is the tanh-sinh quadrature of the quantile
     # function; the closed forms must agree to 1e-12 relative up to m = 1e9.
     law = CLOSED_FORMS[case]
-    closed = law.mean_max(M_VALUES, lower)
-    generic = Distribution.mean_max(law, M_VALUES, lower)
+    closed = law.mean_max_above(M_VALUES, lower)
+    generic = Distribution.mean_max_above(law, M_VALUES, lower)
     np.testing.assert_allclose(closed, generic, rtol=1e-12)
 
 
 def test_closed_forms_known_values():
-    assert float(Uniform(0.45, 0.65).mean_max(3, lower=0.5)) == pytest.approx(0.5 + 0.15 * 3 / 4, rel=1e-15)
-    assert float(Exponential(0.05, 0.45).mean_max(4, lower=0.5)) == pytest.approx(0.5 + 0.05 * 25 / 12, rel=1e-15)
+    uniform = TruncatedBelow(Uniform(0.45, 0.65), MU_D, "uniform")
+    exponential = TruncatedBelow(Exponential(0.05, 0.45), MU_D, "exponential")
+    assert float(uniform.mean_max(3)) == pytest.approx(0.5 + 0.15 * 3 / 4, rel=1e-15)
+    assert float(exponential.mean_max(4)) == pytest.approx(0.5 + 0.05 * 25 / 12, rel=1e-15)
     # Pareto alpha = 2, m = 2: s Gamma(1/2) Gamma(3) / Gamma(5/2) = s 8/3.
     assert float(Pareto(2.0, 0.05, 0.5).mean_max(2)) == pytest.approx(0.5 + 0.05 * 8 / 3, rel=1e-14)
     assert float(Pareto(1.0, 0.05, 0.5).mean_max(2)) == math.inf

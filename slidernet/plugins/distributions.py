@@ -10,14 +10,20 @@ A distribution plugin is any object with
   and ``check_mu_d(mu_d)`` (raise :class:`~slidernet.errors.ConfigError`
   when the parameters make no sense for that mu_d).
 
+A *law of mu_s* is a :class:`Distribution`: ``sample``, ``cdf``, ``sf``,
+``ppf``, ``isf``, ``support`` and ``mean_max(m)``, the exact mean of the
+largest of ``m`` draws of that law. The built-ins are Distributions, and so
+is the law slidernet draws from.
+
 The model requires p(mu_s) = 0 for mu_s <= mu_d (the paper, section II.A).
-slidernet enforces this for every plugin with :class:`TruncatedBelow`: draws
-at or below mu_d are rejected and redrawn, and the cdf is renormalised. For a
-law whose support starts above mu_d the truncation changes nothing. The
-solver reads its draws through a :class:`TruncatedStream`, which calls the
-plugin with a fixed number of draws (:data:`RAW_CHUNK`) and keeps the
-accepted ones it has not handed out yet, so that the values never depend on
-``solver.batch``.
+slidernet enforces this for every plugin with :class:`TruncatedBelow`, the
+Distribution that ``load_config(...).distribution()`` returns and the
+solver, the theory and the paper figures use: draws at or below mu_d are
+rejected and redrawn, and the cdf is renormalised. For a law whose support
+starts above mu_d the truncation changes nothing. The solver reads its
+draws through a :class:`TruncatedStream`, which calls the plugin with a
+fixed number of draws (:data:`RAW_CHUNK`) and keeps the accepted ones it has
+not handed out yet, so that the values never depend on ``solver.batch``.
 
 The built-ins (:data:`BUILTINS`, by the name a config uses) and the
 extreme-value class of the maximum of many draws (what mu_max ages like):
@@ -35,15 +41,17 @@ name             law                                        class of the maximum
 ``scipy``        any continuous ``scipy.stats`` law         depends on the law
 ===============  =========================================  =========================
 
-All built-ins subclass :class:`Distribution` and add ``ppf``, ``isf``,
-``support()`` and ``mean_max(m, lower)``: the exact mean of the largest of
-``m`` draws of the law conditioned on mu_s > lower, in closed form where one
-exists (uniform, exponential, pareto, empirical) and otherwise by
-:func:`mean_max_quadrature`.
+``mean_max(m)`` is the same on every Distribution: the exact mean of the
+largest of ``m`` draws of *that* law -- a built-in as its parameters give
+it, a :class:`TruncatedBelow` conditioned on mu_s > mu_d. The truncated law
+takes it from the built-in's ``mean_max_above(m, lower)``, the same mean
+conditioned on mu_s > lower, in closed form where one exists (uniform,
+exponential, pareto, empirical) and otherwise by :func:`mean_max_quadrature`.
 """
 
 from __future__ import annotations
 
+import abc
 import csv
 import math
 import os
@@ -119,7 +127,7 @@ def _tanh_sinh_rule() -> tuple[np.ndarray, np.ndarray]:
 _TS_LOG_P, _TS_WEIGHTS = _tanh_sinh_rule()
 
 
-def mean_max_quadrature(dist: Any, m: ArrayLike) -> np.ndarray:
+def mean_max_quadrature(dist: Distribution, m: ArrayLike) -> np.ndarray:
     r"""Mean of the largest of ``m`` i.i.d. draws of ``dist``, by quadrature.
 
     With Q the quantile function of ``dist``, the maximum of m draws has the
@@ -137,9 +145,8 @@ def mean_max_quadrature(dist: Any, m: ArrayLike) -> np.ndarray:
 
     Parameters
     ----------
-    dist : object
-        A distribution with ``ppf(u)`` and ``isf(q)`` (every built-in, and
-        :class:`TruncatedBelow`), vectorised.
+    dist : Distribution
+        The law; only its ``ppf(u)`` and ``isf(q)`` are used, vectorised.
     m : float or array_like
         Number(s) of draws, >= 1 (need not be integers: F^m is used), any shape.
 
@@ -162,18 +169,29 @@ def mean_max_quadrature(dist: Any, m: ArrayLike) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------
-# base class of the built-ins
+# the law of mu_s: base class of the built-ins and of the truncated law
 
 
-class Distribution:
-    """Base class of the built-in laws of mu_s (before truncation at mu_d).
+class Distribution(abc.ABC):
+    """A law of mu_s: the built-ins, and the law slidernet draws from.
 
-    A subclass defines ``sample``, ``cdf``, ``sf``, ``ppf``, ``isf`` and
-    ``support``; this class adds :meth:`check_mu_d` and a generic
-    :meth:`mean_max`. ``name`` is the registered name, ``_mu_d_param``
-    the parameter blamed when the law leaves too little mass above mu_d, and
-    ``example_params`` a valid parameter set for mu_d = 0.5 (used by
-    :func:`slidernet.testing.check_distribution` and the contract tests).
+    One interface in the style of ``scipy.stats``: ``sample``, ``cdf``,
+    ``sf``, ``ppf``, ``isf``, ``support`` and :meth:`mean_max`. The built-ins
+    subclass it (each a law before truncation at mu_d), and so does
+    :class:`TruncatedBelow`, the law conditioned on mu_s > mu_d that
+    ``load_config(...).distribution()`` returns. A third-party plugin need
+    not subclass it (``sample`` and ``cdf`` are enough): slidernet wraps it in
+    a TruncatedBelow, which is a Distribution.
+
+    A subclass defines the abstract methods; this class adds
+    :meth:`check_mu_d`, :meth:`mean_max` and :meth:`mean_max_above` (by
+    :func:`mean_max_quadrature`). A law with a closed form for the mean of
+    the maximum overrides :meth:`mean_max_above` only, and :meth:`mean_max`
+    follows. ``name`` is the registered name, ``_mu_d_param`` the parameter
+    blamed when the law leaves too little mass above mu_d, and
+    ``example_params`` (on the built-ins) a valid parameter set for
+    mu_d = 0.5, used by :func:`slidernet.testing.check_distribution` and the
+    contract tests.
     """
 
     name = "distribution"
@@ -182,9 +200,42 @@ class Distribution:
     # a law whose support starts above mu_d loses nothing.
     truncate_below_mu_d: ClassVar[bool] = True
 
+    @abc.abstractmethod
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """``size`` independent draws of mu_s (dimensionless), using only ``rng``.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The stream to draw from.
+        size : int
+            Number of draws, >= 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            float64, shape ``(size,)``.
+        """
+
+    @abc.abstractmethod
+    def cdf(self, x: ArrayLike) -> np.ndarray:
+        """P(mu_s <= x), elementwise; x dimensionless, any shape; result of the shape of ``x``."""
+
+    @abc.abstractmethod
+    def sf(self, x: ArrayLike) -> np.ndarray:
+        """P(mu_s > x) = 1 - cdf(x), accurate in the upper tail; shape of ``x``."""
+
+    @abc.abstractmethod
+    def ppf(self, u: ArrayLike) -> np.ndarray:
+        """The quantile: the x with P(mu_s <= x) = u, u in [0, 1]; shape of ``u``."""
+
+    @abc.abstractmethod
+    def isf(self, q: ArrayLike) -> np.ndarray:
+        """The x with P(mu_s > x) = q, q in [0, 1], accurate for tiny q; shape of ``q``."""
+
+    @abc.abstractmethod
     def support(self) -> tuple[float, float]:
         """Lower and upper end of the support (may be infinite)."""
-        raise NotImplementedError
 
     def _params(self) -> dict[str, Any]:
         return {}
@@ -209,31 +260,56 @@ class Distribution:
             raise param_error(param, self.name, f"such that P(mu_s > mu_d = {mu_d!r}) >= {MIN_MASS!r} "
                               f"(it is {mass:.3g})", got)
 
-    def _truncated(self, lower: float | None) -> Distribution | TruncatedBelow:
+    def _truncated(self, lower: float) -> Distribution:
         """This law conditioned on mu_s > lower (itself where that changes nothing)."""
-        if lower is None or float(lower) <= self.support()[0]:
+        if float(lower) <= self.support()[0]:
             return self
         return TruncatedBelow(self, float(lower), self.name, min_mass=np.finfo(float).tiny)
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
-        """Exact mean of the largest of ``m`` i.i.d. draws, conditioned on mu_s > ``lower``.
+    def mean_max(self, m: ArrayLike) -> np.ndarray:
+        """Exact mean of the largest of ``m`` i.i.d. draws of this law.
 
-        ``lower=None`` (or a ``lower`` below the support) gives the law as it
-        is. :class:`TruncatedBelow` calls this with ``lower = mu_d``, which is
-        the law slidernet draws from. Here by :func:`mean_max_quadrature`;
-        some subclasses have a closed form.
+        On the law slidernet draws from (``load_config(...).distribution()``,
+        a :class:`TruncatedBelow`) this is mu_max of the two-slider system
+        after ``n = m - 2`` rearrangements, on average.
 
         Parameters
         ----------
         m : float or array_like
-            Number(s) of draws, >= 1, any shape.
-        lower : float, optional
-            Truncation point (mu_d).
+            Number(s) of draws, >= 1 (need not be integers), any shape.
 
         Returns
         -------
         numpy.ndarray
             E[max], dimensionless like mu_s, shape of ``m``.
+
+        Raises
+        ------
+        ConfigError
+            If an ``m`` is not finite or is below 1.
+        """
+        # Conditioning on mu_s > -inf leaves the law as it is: one code path
+        # (closed form or quadrature) per law.
+        return self.mean_max_above(m, -math.inf)
+
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Exact mean of the largest of ``m`` i.i.d. draws, conditioned on mu_s > ``lower``.
+
+        This is what :meth:`TruncatedBelow.mean_max` asks of a built-in, with
+        ``lower = mu_d``. A ``lower`` at or below the support changes nothing.
+        Here by :func:`mean_max_quadrature`; some subclasses have a closed form.
+
+        Parameters
+        ----------
+        m : float or array_like
+            Number(s) of draws, >= 1, any shape.
+        lower : float
+            Truncation point (mu_d), dimensionless; ``-inf`` for none.
+
+        Returns
+        -------
+        numpy.ndarray
+            E[max | mu_s > lower], dimensionless like mu_s, shape of ``m``.
         """
         return mean_max_quadrature(self._truncated(lower), m)
 
@@ -378,10 +454,10 @@ class Uniform(Distribution):
         """The x with P(mu_s > x) = q."""
         return self.high - np.asarray(q, dtype=float) * self.width
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
-        """Closed form: a + (high - a) m / (m + 1), a = max(low, lower); see :meth:`Distribution.mean_max`."""
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Closed form a + (high - a) m / (m + 1), a = max(low, lower); see :meth:`Distribution.mean_max_above`."""
         m_arr = _check_m(m)
-        a = self.low if lower is None else max(self.low, float(lower))
+        a = max(self.low, float(lower))
         if a >= self.high:
             raise param_error("high", self.name, f"> lower = {lower!r}", self.high)
         return a + (self.high - a) * m_arr / (m_arr + 1.0)
@@ -585,10 +661,10 @@ class Exponential(Distribution):
         """The x with P(mu_s > x) = q, accurate for tiny q."""
         return self.loc - self.scale * np.log(np.asarray(q, dtype=float))
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
-        """Closed form: a + scale H_m, a = max(loc, lower); see :meth:`Distribution.mean_max`."""
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Closed form: a + scale H_m, a = max(loc, lower); see :meth:`Distribution.mean_max_above`."""
         m_arr = _check_m(m)
-        a = self.loc if lower is None else max(self.loc, float(lower))
+        a = max(self.loc, float(lower))
         # H_m = psi(m + 1) + gamma, also for non-integer m.
         return a + self.scale * (special.digamma(m_arr + 1.0) + np.euler_gamma)
 
@@ -661,10 +737,10 @@ class Pareto(Distribution):
         """The x with P(mu_s > x) = q, accurate for tiny q."""
         return self.loc + self.scale * np.asarray(q, dtype=float) ** (-1.0 / self.alpha)
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
-        """Closed form (inf for alpha <= 1); see the class docstring and :meth:`Distribution.mean_max`."""
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Closed form (inf for alpha <= 1); see the class docstring and :meth:`Distribution.mean_max_above`."""
         m_arr = _check_m(m)
-        s = self.scale if lower is None else max(self.scale, float(lower) - self.loc)
+        s = max(self.scale, float(lower) - self.loc)
         if self.alpha <= 1.0:
             return np.full(m_arr.shape, math.inf)
         a = 1.0 / self.alpha
@@ -708,7 +784,7 @@ class Empirical(Distribution):
     ...     d = Empirical(path, column="mu_s")
     >>> d.values.tolist(), float(d.cdf(0.65))
     ([0.4, 0.6, 0.7], 0.6666666666666666)
-    >>> round(float(d.mean_max(2, lower=0.5)), 12)  # 0.6 / 4 + 0.7 * 3 / 4
+    >>> round(float(TruncatedBelow(d, lower=0.5, name="empirical").mean_max(2)), 12)  # 0.6 / 4 + 0.7 * 3 / 4
     0.675
     """
 
@@ -812,10 +888,10 @@ class Empirical(Distribution):
         """The smallest value v with a fraction <= q of values above it."""
         return self.ppf(1.0 - np.asarray(q, dtype=float))
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
-        """Exact for the ECDF: sum_k v_(k) [(k/K)^m - ((k-1)/K)^m]; see :meth:`Distribution.mean_max`."""
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Exact for the ECDF: sum_k v_(k) [(k/K)^m - ((k-1)/K)^m]; see :meth:`Distribution.mean_max_above`."""
         m_arr = _check_m(m)
-        v = self.values if lower is None else self.values[self.values > float(lower)]
+        v = self.values[self.values > float(lower)]
         if v.size == 0:
             raise param_error("path", self.name, f"a file with values > lower = {lower!r}", self.path)
         k = np.arange(v.size + 1) / v.size
@@ -915,20 +991,28 @@ distribution of scipy.stats (e.g. 'gamma'). Got 'poisson' instead.
         """The x with P(mu_s > x) = q."""
         return np.asarray(self.frozen.isf(q), dtype=float)
 
-    def mean_max(self, m: ArrayLike, lower: float | None = None) -> np.ndarray:
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """By quadrature; inf where scipy says the law's mean is infinite, NaN where undefined."""
         mean = float(self.frozen.mean())
         if not math.isfinite(mean):
             return np.full(_check_m(m).shape, mean if mean == math.inf else math.nan)
-        return super().mean_max(m, lower)
+        return super().mean_max_above(m, lower)
 
 
 # ---------------------------------------------------------------------------
 # truncation below mu_d
 
 
-class TruncatedBelow:
-    """A distribution conditioned on mu_s > ``lower`` (normally mu_d), or checked to be.
+class TruncatedBelow(Distribution):
+    """A law of mu_s conditioned on mu_s > ``lower`` (normally mu_d), or checked to be.
+
+    This is the law slidernet draws from: ``load_config(...).distribution()``
+    returns one, the solver draws its thresholds from it (through a
+    :class:`TruncatedStream`), and :mod:`slidernet.analysis.theory` and the
+    paper figures compare against it. It is a :class:`Distribution` like the
+    built-ins, whatever the plugin it wraps: ``sample``, ``cdf``, ``sf``,
+    ``ppf``, ``isf``, ``support`` and ``mean_max(m)`` all describe the
+    conditioned law.
 
     The model needs p(mu_s) = 0 for mu_s <= mu_d. A plugin that declares
     ``truncate_below_mu_d = True`` (every built-in does) is conditioned on
@@ -941,8 +1025,9 @@ class TruncatedBelow:
 
     Parameters
     ----------
-    dist : object
-        The plugin distribution (``sample`` and ``cdf``; ``sf`` and ``isf`` optional).
+    dist : Distribution or object
+        The plugin distribution: a :class:`Distribution`, or any object with
+        ``sample`` and ``cdf`` (``sf``, ``isf`` and ``support`` optional).
     lower : float
         The truncation point (mu_d); draws must be strictly above it.
     name : str
@@ -959,6 +1044,8 @@ class TruncatedBelow:
     >>> round(float(d.cdf(0.5)), 12)
     0.0
     >>> u = TruncatedBelow(Uniform(0.4, 0.6), lower=0.5, name="uniform")
+    >>> isinstance(u, Distribution), u.support()
+    (True, (0.5, 0.6))
     >>> round(float(u.mean_max(3)), 12)  # the max of 3 draws of Uniform(0.5, 0.6)
     0.575
     """
@@ -988,6 +1075,33 @@ class TruncatedBelow:
         if sf is not None:
             return np.asarray(sf(x), dtype=float)
         return 1.0 - np.asarray(self.dist.cdf(x), dtype=float)
+
+    def support(self) -> tuple[float, float]:
+        """(max(lower, plugin's lower end), plugin's upper end); inf for an end the plugin does not give."""
+        plugin = getattr(self.dist, "support", None)
+        lo, hi = plugin() if plugin is not None else (-math.inf, math.inf)
+        return max(self.lower, float(lo)), float(hi)
+
+    def check_mu_d(self, mu_d: float) -> None:
+        """Refuse a law with less than :data:`MIN_MASS` of probability above ``mu_d``.
+
+        The plugin's own ``check_mu_d`` is asked first, since its message
+        names the parameter to change; then the conditioned law's mass.
+
+        Raises
+        ------
+        ConfigError
+            If the plugin refuses ``mu_d``, or P(mu_s > mu_d | mu_s > lower) < MIN_MASS.
+        """
+        check = getattr(self.dist, "check_mu_d", None)
+        if check is not None:
+            check(mu_d)
+        mass = float(self.sf(float(mu_d)))
+        if not mass >= MIN_MASS:
+            raise ConfigError(
+                f"The distribution {self.name!r}, conditioned on mu_s > {self.lower!r}, puts probability "
+                f"{mass!r} above mu_d = {mu_d!r}; at least {MIN_MASS!r} is needed."
+            )
 
     def _checked(self, draws: object, size: int) -> np.ndarray:
 
@@ -1111,23 +1225,33 @@ class TruncatedBelow:
 
         This is the law slidernet draws from: after ``n`` rearrangements of
         the two-slider system, mu_max is the largest of ``m = n + 2`` draws.
-        A built-in computes it itself (``dist.mean_max(m, lower)``, a closed
-        form where there is one); any other plugin goes through
-        :func:`mean_max_quadrature` on this object.
+        A built-in computes it itself (``dist.mean_max_above(m, lower)``, a
+        closed form where there is one); any other plugin goes through
+        :func:`mean_max_quadrature` on this object. Where the plugin's
+        support starts above ``lower`` it equals the plugin's ``mean_max(m)``.
 
         Parameters
         ----------
         m : float or array_like
-            Number(s) of draws, >= 1, any shape.
+            Number(s) of draws, >= 1 (need not be integers), any shape.
 
         Returns
         -------
         numpy.ndarray
-            E[max], dimensionless like mu_s, shape of ``m``.
+            E[max | mu_s > lower], dimensionless like mu_s, shape of ``m``.
+        """
+        return self.mean_max_above(m, self.lower)
+
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """Exact mean of the largest of ``m`` draws of this law, conditioned further on mu_s > ``lower``.
+
+        Conditioning on mu_s > a and then on mu_s > b is conditioning on
+        mu_s > max(a, b); a ``lower`` at or below :attr:`lower` changes nothing.
+        See :meth:`Distribution.mean_max_above`.
         """
         if isinstance(self.dist, Distribution):
-            return self.dist.mean_max(m, lower=self.lower)
-        return mean_max_quadrature(self, m)
+            return self.dist.mean_max_above(m, max(self.lower, float(lower)))
+        return super().mean_max_above(m, lower)
 
     def __repr__(self) -> str:
         return f"TruncatedBelow({self.dist!r}, lower={self.lower!r})"
