@@ -420,15 +420,14 @@ class Config(_Strict):
                 built = build_network(self)
             except (SlidernetError, OSError):
                 return None, False  # building the scene reports the file itself
-            pair = built.is_two_slider() and self.solver.kernel in ("auto", "pair")
-            return built.dim, pair
+            kernel = choose_kernel(self.solver.kernel, built.is_two_slider(), built.dim,
+                                   "events" in self.observables)
+            return built.dim, kernel == "pair"
         dim = 1 if net.kind in ("two_slider", "chain") else 2
         defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.f_ext
         two = net.kind == "two_slider" or (net.kind == "chain" and net.n == 2)
-        # solver.Scene picks the pair kernel for the paper's scene unless the event catalogue is asked for.
-        pair = self.solver.kernel == "pair" or (
-            self.solver.kernel == "auto" and two and defaults and "events" not in self.observables)
-        return dim, pair
+        kernel = choose_kernel(self.solver.kernel, two and defaults, dim, "events" in self.observables)
+        return dim, kernel == "pair"
 
     def distribution(self) -> TruncatedBelow:
         """The mu_s distribution, truncated below mu_d (built once, cached)."""
@@ -601,3 +600,24 @@ def build_network(cfg: Config) -> Network:
     # seed None means 0, not fresh entropy: a network is part of the scene.
     rng = np.random.Generator(np.random.PCG64(net_cfg.seed or 0))
     return build(net_cfg.kind, params, net_cfg.Ntilde, rng)
+
+
+def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -> str:
+    """The kernel a scene runs on: the one rule, used by the scene and by the checks of a configuration.
+
+    ``auto`` gives ``pair`` (scalars only) for the paper's two sliders unless
+    the event catalogue is asked for (it needs per-node state), and else the
+    network kernel of the dimension: ``csr`` in 1D, ``vec`` in 2D. A kernel
+    named in ``solver.kernel`` is returned as it is (the scene refuses one
+    that cannot run its network).
+
+    >>> [choose_kernel("auto", True, 1, False), choose_kernel("auto", True, 1, True)]
+    ['pair', 'csr']
+    >>> choose_kernel("auto", False, 2, False)
+    'vec'
+    """
+    if requested != "auto":
+        return requested
+    if two_slider and not catalogue:
+        return "pair"
+    return "csr" if dim == 1 else "vec"

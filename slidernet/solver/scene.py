@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from slidernet.config import Config, build_network
+from slidernet.config import Config, build_network, choose_kernel
 from slidernet.errors import ConfigError
 from slidernet.model.network import Network
 
@@ -128,11 +128,8 @@ class Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
         family, K, ops = _operators(net)
-        kernel = cfg.solver.kernel
         catalogue = "events" in cfg.observables
-        if kernel == "auto":
-            # The pair kernel keeps scalars only: no per-node event catalogue.
-            kernel = "pair" if net.is_two_slider() and not catalogue else family
+        kernel = choose_kernel(cfg.solver.kernel, net.is_two_slider(), net.dim, catalogue)
         if kernel != family and not (kernel == "pair" and net.is_two_slider()):
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
