@@ -1,4 +1,4 @@
-"""Error of the straight-line 2D slip against the integrated 2D slip (MODEL.md section 2).
+"""Error of the straight-line 2D slip against the integrated 2D slip (docs/model.md section 2).
 
     python benchmarks/slip_error.py [--quick] [--out DIR]
 

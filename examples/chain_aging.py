@@ -1,4 +1,4 @@
-"""Aging of the strongest threshold in chains of 2, 4 and 8 sliders (MODEL.md sections 2 and 4).
+"""Aging of the strongest threshold in chains of 2, 4 and 8 sliders (docs/model.md sections 2 and 4).
 
 Each chain (free ends, kind ``chain``) is cycled in temperature with the
 driver ``gaussian_steps``. The figure shows the ensemble mean of mu_max

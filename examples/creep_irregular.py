@@ -1,4 +1,4 @@
-"""Creep of an irregular network under a constant load and thermal cycling (MODEL.md section 2).
+"""Creep of an irregular network under a constant load and thermal cycling (docs/model.md section 2).
 
 An irregular network (``n`` random points joined by their Delaunay
 triangulation, a fixed network seed) carries the same tangential force

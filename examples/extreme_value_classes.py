@@ -1,4 +1,4 @@
-"""Aging of mu_max in the three extreme-value classes (two sliders, MODEL.md sections 1 and 4).
+"""Aging of mu_max in the three extreme-value classes (two sliders, docs/model.md sections 1 and 4).
 
 In the two-slider system only the weaker slider ever slips, so after n
 rearrangements mu_max is exactly the largest of the n + 2 thresholds drawn

@@ -5,7 +5,7 @@ Writes ``result.nc``, ``slip_map.png`` (slips per node, log scale) and
 
     python examples/lattice_pictures.py --out out/lattice
 
-Only the boundary feels the dilation directly (MODEL.md section 2), so the
+Only the boundary feels the dilation directly (docs/model.md section 2), so the
 boundary nodes slip most and the count falls towards the centre.
 """
 

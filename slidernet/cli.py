@@ -38,7 +38,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     r = sub.add_parser("run", help="run a configuration and write DIR/result.nc")
-    r.add_argument("config", type=Path, help="TOML configuration (see MODEL.md section 5)")
+    r.add_argument("config", type=Path, help="TOML configuration (see docs/model.md section 5)")
     r.add_argument("--out", type=Path, required=True, help="output directory")
     _progress_flag(r)
     _execution_flags(r)
@@ -48,7 +48,7 @@ def _parser() -> argparse.ArgumentParser:
         description="Each --set KEY=V1,V2,... adds a dimension; the grid is their product. Every point uses "
                     "the configuration's seed, so a point equals the plain run of its configuration.",
     )
-    sw.add_argument("config", type=Path, help="TOML configuration (see MODEL.md section 5)")
+    sw.add_argument("config", type=Path, help="TOML configuration (see docs/model.md section 5)")
     sw.add_argument("--set", dest="sets", action="append", required=True, metavar="KEY=V1,V2,...",
                     help="a dotted configuration key and its values, e.g. driver.sigma_theta=1e-7,1e-6")
     sw.add_argument("--out", type=Path, required=True, help="output directory")

@@ -476,7 +476,7 @@ def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
 
 
 def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
-    """Build the mu_s plugin and truncate it below mu_d (MODEL.md section 1)."""
+    """Build the mu_s plugin and truncate it below mu_d (docs/model.md section 1)."""
     dist = _build_plugin(registry.distributions, friction.static, "friction.static")
     check = getattr(dist, "check_mu_d", None)
     if check is not None:
@@ -547,7 +547,7 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     Parameters
     ----------
     source : Config, mapping, or path
-        A :class:`Config`, a dict with the keys of MODEL.md section 5, or the
+        A :class:`Config`, a dict with the keys of docs/model.md section 5, or the
         path of a TOML file with those keys.
 
     Returns

@@ -18,7 +18,7 @@ from slidernet.solver import Realization, Scene
 settings.register_profile("slidernet", deadline=None)
 settings.load_profile("slidernet")
 
-# MODEL.md section 5, as a dict, exactly as written there.
+# docs/model.md section 5, as a dict, exactly as written there.
 REFERENCE: dict[str, Any] = {
     "seed": 1,
     "realizations": 200,

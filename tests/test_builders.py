@@ -1,6 +1,6 @@
 """Tests of slidernet.model.builders: lattices, Delaunay networks, graph files and the build dispatch.
 
-Geometry and linear-elasticity checks (MODEL.md section 2): lattice springs all
+Geometry and linear-elasticity checks (docs/model.md section 2): lattice springs all
 have length 1, the thermal load g = B^T (k L kappa) vanishes on interior nodes
 of a uniform lattice, forces are invariant under rigid-body motions (K u = 0
 and g . u = 0 for translations and the infinitesimal rotation).

@@ -20,7 +20,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-# MODEL.md section 5, verbatim.
+# docs/model.md section 5, verbatim.
 REFERENCE_TOML = """\
 seed = 1
 realizations = 200
@@ -263,7 +263,7 @@ def test_reference_toml_loads_and_equals_the_dict(tmp_path):
 
 
 def test_reference_toml_runs_with_fewer_steps(tmp_path):
-    # The TOML of MODEL.md section 5, with steps 10000 -> 100 and
+    # The TOML of docs/model.md section 5, with steps 10000 -> 100 and
     # realizations 200 -> 3 by editing the parsed dict (to keep the test fast).
     path = tmp_path / "paper.toml"
     path.write_text(REFERENCE_TOML)
@@ -278,7 +278,7 @@ def test_reference_toml_runs_with_fewer_steps(tmp_path):
 
 
 def test_model_md_example_dict_runs_as_written():
-    # MODEL.md section 5 as a dict, unchanged except steps 10000 -> 200 and
+    # docs/model.md section 5 as a dict, unchanged except steps 10000 -> 200 and
     # realizations 200 -> 4 (the full run takes minutes).
     cfg = make_config(steps=200, realizations=4)
     assert {k: v for k, v in cfg.items() if k not in ("steps", "realizations")} == {

@@ -404,7 +404,7 @@ def single_threshold(tmp_path: Path) -> dict[str, Any]:
 def test_tied_sliders_slip_lowest_index_first_and_nothing_loops(single_threshold):
     # Both sliders feel |F| = |theta - u| and hold mu_s = 0.6: they reach their
     # thresholds at the same theta, always. Ties go to the lowest index
-    # (MODEL.md section 2), so slider 0 makes every slip and slider 1 none; the
+    # (docs/model.md section 2), so slider 0 makes every slip and slider 1 none; the
     # pair kernel gives the same bits as the csr kernel.
     steps = 1000
     base = hard_config(TWO, 10.0, steps=steps, observables=["n", "mu_max", "x_G", "events"])

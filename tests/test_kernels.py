@@ -179,7 +179,7 @@ def test_realization_single_slip(fixed_driver, s, seed):
 
 
 def tilt_reference(F, mu1, mu2, mu_d, tmu, tu):
-    """MODEL.md section 1, "The virtual tilt test", steps 1-3, written from the text.
+    """docs/model.md section 1, "The virtual tilt test", steps 1-3, written from the text.
 
     Returns (f, draws of thresholds used, uniforms used); raises IndexError
     when the buffers run out.
@@ -327,7 +327,7 @@ def test_pair_and_csr_kernels_agree_to_the_bit(case, tilt):
 @pytest.mark.parametrize("kernel", ["pair", "csr"])
 @pytest.mark.parametrize("case", ["reference", "avalanches"])
 def test_one_tilt_test_per_rearrangement(kernel, case):
-    # MODEL.md: mu_eff pools one tilt test per rearrangement (plus one on the
+    # docs/model.md: mu_eff pools one tilt test per rearrangement (plus one on the
     # initial state, bin t = 0). batch = 16 forces a refill every 16 slips.
     changes = {"steps": 100, "observables": ["n", "mu_eff"], "solver.batch": 16,
                "solver.kernel": kernel, **AGREEMENT_CASES[case]}

@@ -55,7 +55,7 @@ def config(phys: dict, network: dict | None = None, **changes) -> dict:
 @FAST
 @given(seed=seeds, phys=physics())
 def test_mu_max_never_decreases_with_two_sliders(seed, phys):
-    # Only the weakest threshold is ever redrawn (MODEL.md section 4).
+    # Only the weakest threshold is ever redrawn (docs/model.md section 4).
     res = simulate(scene_of(config(phys, steps=60, record="all")), np.random.SeedSequence(seed))
     assert (np.diff(res["mu_max"]) >= 0).all()
     assert (np.diff(res["n_records"]) >= 0).all()

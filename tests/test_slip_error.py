@@ -1,4 +1,4 @@
-"""Facts that benchmarks/slip_error.py relies on (MODEL.md section 2, the 2D slip rule).
+"""Facts that benchmarks/slip_error.py relies on (docs/model.md section 2, the 2D slip rule).
 
 * The straight-line slip is exact where K_ii is isotropic, and along either
   eigen-axis of an anisotropic K_ii; the benchmark's reference integrator and

@@ -75,7 +75,7 @@ def reference_moments(dist: TruncatedBelow, n: float, sigma: float) -> tuple[flo
 def two_slider_thresholds(dist, n_max: int, rows: int, seed: int, record_at: set[int]):
     """Run the threshold dynamics of the two-slider model for ``rows`` realizations.
 
-    Each rearrangement redraws the weaker of the two thresholds (MODEL.md,
+    Each rearrangement redraws the weaker of the two thresholds (docs/model.md,
     section 1). Returns, for each n in ``record_at``, mu_max and the number
     of times the strongest slider changed.
     """
@@ -276,7 +276,7 @@ def test_mu_max_leading_values():
 
 
 def test_mu_max_leading_overestimates_by_04_to_05_sigma():
-    # MODEL.md section 4: for n = 1e3..1e6 eq. mumaxth overestimates the exact
+    # docs/model.md section 4: for n = 1e3..1e6 eq. mumaxth overestimates the exact
     # mean maximum by 0.4-0.5 sigma_mu. We measure (leading - exact mean) /
     # sigma_mu on 31 log-spaced n: it falls monotonically from 0.475 (n = 1e3)
     # to 0.394 (n = 1e6), i.e. the statement holds to its one significant digit

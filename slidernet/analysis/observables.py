@@ -1,4 +1,4 @@
-"""From per-realization records to the result dataset (MODEL.md section 3).
+"""From per-realization records to the result dataset (docs/model.md section 3).
 
 Per realization (dims ``realization, t``): ``n``, ``mu_max``, ``x_G`` and
 ``n_records``. Ensemble statistics (dim ``t``): ``<name>_mean`` and
@@ -40,7 +40,7 @@ summed in the same order whatever the number of workers or checkpoints."""
 
 
 def _network_variables(ds: Variables, records: list[Record], first_realization: int) -> None:
-    """Variables that only network kernels record (MODEL.md: networks add their own)."""
+    """Variables that only network kernels record (docs/model.md: networks add their own)."""
     first = records[0]
     per_t = {
         "y_G": ("centre-of-mass displacement along y since t = 0", "l0"),

@@ -1,10 +1,10 @@
 """Closed-form predictions of the two-slider model (the paper's section IV).
 
 Everything here is a reference to compare simulations against; nothing is
-simulated. Units follow MODEL.md: lengths in l0, time in tau_th, friction
+simulated. Units follow docs/model.md: lengths in l0, time in tau_th, friction
 coefficients dimensionless. ``n`` is always the number of rearrangements
 since t = 0, so the initial state holds two drawn thresholds and after ``n``
-rearrangements ``n + 2`` thresholds have been drawn in all (MODEL.md,
+rearrangements ``n + 2`` thresholds have been drawn in all (docs/model.md,
 section 4). The paper counts from an initial step n = 1 and therefore writes
 ``n + 1`` for the same number.
 
@@ -144,7 +144,7 @@ def mean_rearrangements(
               {\sqrt{\pi}\,(\bar\mu_s - \mu_d)\,\tilde N},
 
     and with ``offset=False`` the plain estimate without the shift
-    :math:`\mu_d \tilde N`. Both are approximations: MODEL.md (section 4)
+    :math:`\mu_d \tilde N`. Both are approximations: docs/model.md (section 4)
     says the first fails when ``sigma_theta`` is below about
     ``2 * mu_d * Ntilde``, and it turns negative, hence meaningless, below
     ``mu_d * Ntilde``. The value is returned as the formula gives it, without
@@ -202,7 +202,7 @@ def mu_max_cdf(dist: Any, mu: ArrayLike, n: ArrayLike) -> np.ndarray:
 
     In the two-slider model only the weaker threshold is ever redrawn, so
     mu_max is the maximum of the ``n + 2`` independent draws (two initial
-    ones and one per rearrangement; MODEL.md, section 4).
+    ones and one per rearrangement; docs/model.md, section 4).
 
     Parameters
     ----------
@@ -513,7 +513,7 @@ def mean_records(n: ArrayLike) -> np.ndarray:
     .. math:: \langle \text{exchanges} \rangle = \sum_{k=3}^{n+2} \frac1k
               = H_{n+2} - H_2 = H_{n+2} - \tfrac32 .
 
-    MODEL.md's "mean H_n" and the paper's "ln n" are the leading-order
+    docs/model.md's "mean H_n" and the paper's "ln n" are the leading-order
     forms of this: H_{n+2} - 3/2 = H_n - 3/2 + O(1/n) = ln n - (3/2 - gamma)
     + O(1/n), so H_n counts 1.5 too many and ln n about 0.92 too many.
 

@@ -71,7 +71,7 @@ def run(
     Parameters
     ----------
     config : Config, dict or path
-        The run configuration (MODEL.md section 5); a path is read as TOML.
+        The run configuration (docs/model.md section 5); a path is read as TOML.
     progress : bool or None
         Show a progress bar over realizations, all workers together (None:
         only on a terminal).

@@ -255,7 +255,7 @@ def sweep(
     Parameters
     ----------
     config : Config, dict or path
-        The base configuration (MODEL.md section 5); a path is read as TOML
+        The base configuration (docs/model.md section 5); a path is read as TOML
         (files it names are found next to it). It need not be valid by
         itself, but every point must be.
     grid : mapping of str to sequence

@@ -1,4 +1,4 @@
-"""The appendix's virtual tilt test for two sliders (MODEL.md section 1)."""
+"""The appendix's virtual tilt test for two sliders (docs/model.md section 1)."""
 
 from __future__ import annotations
 

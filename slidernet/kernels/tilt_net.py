@@ -1,4 +1,4 @@
-"""The virtual tilt test of a whole network (MODEL.md section 1, generalized to N sliders).
+"""The virtual tilt test of a whole network (docs/model.md section 1, generalized to N sliders).
 
 On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
 = f) is added to every node and f is raised quasi-statically:

@@ -1,4 +1,4 @@
-"""Networks of sliders: nodes are sliders, edges are springs (MODEL.md section 2).
+"""Networks of sliders: nodes are sliders, edges are springs (docs/model.md section 2).
 
 Units (the same everywhere in slidernet's internals):
 

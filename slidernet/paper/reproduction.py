@@ -2,7 +2,7 @@
 
 :func:`reproduce` runs the two-slider model at the captions' parameters
 (mu_d = 0.5, mean mu_s = 0.6, sigma_mu = 0.01, Ntilde = 1e-7, sigma_theta
-from 1e-7 to 1e-5; MODEL.md section 1), overlays the closed forms of
+from 1e-7 to 1e-5; docs/model.md section 1), overlays the closed forms of
 :mod:`slidernet.analysis.theory` and writes, in ``out_dir``:
 
 =========================  ====================================================
