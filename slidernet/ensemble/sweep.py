@@ -76,6 +76,7 @@ from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
 from slidernet.io import atomic_output, write_netcdf
+from slidernet.io.store import check_output_dir
 from slidernet.solver import Scene, record_times
 
 if sys.version_info >= (3, 11):
@@ -398,8 +399,7 @@ def _identity(base: dict[str, Any], grid: dict[str, list[Any]]) -> dict[str, Any
 
 def _clear_folder(folder: Path) -> None:
     """Remove what a sweep writes in ``folder`` (``overwrite``): its identity, points and result."""
-    if folder.exists() and not folder.is_dir():
-        raise OutputError(f"The output directory {str(folder)!r} is a file; name a folder.")
+    check_output_dir(folder)
     for name in (_SWEEP_JSON, "result.nc"):
         (folder / name).unlink(missing_ok=True)
     shutil.rmtree(folder / "points", ignore_errors=True)

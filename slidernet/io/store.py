@@ -85,8 +85,7 @@ class RunStore:
             another run's checkpoint, or nothing to resume.
         """
         out = self.dir.parent
-        if out.exists() and not out.is_dir():
-            raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
+        check_output_dir(out)
         run_json = self.dir / "run.json"
         result = out / "result.nc"
         if result.exists() and not run_json.exists() and not (self.overwrite or self.resume):
@@ -133,7 +132,7 @@ class RunStore:
                 tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
         except OSError as exc:
             self.abandon()
-            raise OutputError(f"Cannot write in the output directory {str(out)!r}: {_reason(exc)}.") from None
+            raise OutputError(f"Cannot write in the output directory {str(out)!r}: {reason(exc)}.") from None
         return int(self.identity["seed"])
 
     def _make_dirs(self) -> None:
@@ -149,7 +148,7 @@ class RunStore:
             except OSError as exc:
                 self.abandon()
                 raise OutputError(
-                    f"Cannot create the output directory {str(self.dir.parent)!r}: {_reason(exc)}.") from None
+                    f"Cannot create the output directory {str(self.dir.parent)!r}: {reason(exc)}.") from None
             else:
                 self._created.append(path)
 
@@ -245,7 +244,13 @@ class RunStore:
         shutil.rmtree(self.dir, ignore_errors=True)
 
 
-def _reason(exc: OSError) -> str:
+def check_output_dir(out: Path) -> None:
+    """Refuse an output directory that is an existing file (the one check every output folder shares)."""
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
+
+
+def reason(exc: OSError) -> str:
     """The OS's words for an error, without the traceback's chain."""
     return exc.strerror or str(exc)
 

@@ -50,6 +50,7 @@ from slidernet.ensemble.runner import run_in
 from slidernet.ensemble.sweep import sweep as run_sweep
 from slidernet.errors import CheckpointError, OutputError, RunInterrupted
 from slidernet.io import write_netcdf
+from slidernet.io.store import check_output_dir, reason
 
 __all__ = ["FULL", "QUICK", "Preset", "reproduce"]
 
@@ -654,8 +655,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
 def _prepare(out: Path, resume: bool, overwrite: bool) -> Path:
     """Check and make the output folder; return the folder of the runs (``out/runs``)."""
     runs = out / "runs"
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
+    check_output_dir(out)
     finished = (out / "summary.json").exists() and not runs.exists()
     if overwrite and not resume:
         shutil.rmtree(runs, ignore_errors=True)
@@ -670,7 +670,7 @@ def _prepare(out: Path, resume: bool, overwrite: bool) -> Path:
     try:
         runs.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"Cannot create the output directory {str(out)!r}: {exc.strerror or exc}.") from None
+        raise OutputError(f"Cannot create the output directory {str(out)!r}: {reason(exc)}.") from None
     return runs
 
 
