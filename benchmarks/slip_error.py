@@ -15,7 +15,7 @@ Per slip
     threshold (|F| = mu_s N), the relative displacement error
     |Delta u_straight - Delta u_exact| / |Delta u_exact| and the error of the
     force left on the node, |K_ii (Delta u_straight - Delta u_exact)| / (mu_s N).
-    "Exact" is ``slidernet.kernels.vec.integrate_slip``, the RK4 integration
+    "Exact" is ``slidernet.kernels.plane.integrate_slip``, the RK4 integration
     of the 2D motion behind ``solver.slip = "exact"``, whose step shrinks
     where the speed is small; the script checks its convergence (4x finer
     steps) and that the kernels' ``exact_slip`` is that integration.
@@ -55,7 +55,7 @@ from numba import njit
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import AvalancheError
-from slidernet.kernels.vec import exact_slip, integrate_slip
+from slidernet.kernels.plane import exact_slip, integrate_slip
 from slidernet.solver import Realization, Scene
 
 MU_D = 0.5
@@ -129,7 +129,7 @@ def reference_slips(F: np.ndarray, k: np.ndarray, fd: float, steps_per_period: i
 
 
 def exact_slips(F: np.ndarray, k: np.ndarray, fd: float) -> tuple[np.ndarray, np.ndarray]:
-    """``slidernet.kernels.vec.exact_slip`` over arrays; steps < 0 where it did not stop."""
+    """``slidernet.kernels.plane.exact_slip`` over arrays; steps < 0 where it did not stop."""
     return _batch_exact_slip(np.ascontiguousarray(F, np.float64), np.ascontiguousarray(k, np.float64),
                              float(fd))
 
@@ -152,7 +152,7 @@ def base_config(network: dict[str, Any], *, slip: str = "straight", steps: int =
 def diagonal_blocks(network: dict[str, Any]) -> np.ndarray:
     """The blocks K_ii of every node, shape (N, 2, 2), in N / (Ntilde l0), as the kernel reads them."""
     scene = Scene.from_config(load_config(base_config(network)))
-    return np.array(scene.ops["kblk"][scene.ops["diagpos"]], dtype=np.float64)
+    return np.array(scene.operators.K_blocks[scene.operators.diag], dtype=np.float64)
 
 
 def anisotropy(k: np.ndarray) -> np.ndarray:

@@ -130,9 +130,10 @@ def test_the_documented_stream_order(empirical_file: Path) -> None:
     for name, child in zip(("driver", "thresholds", "tilt"), children, strict=True):
         assert np.random.Generator(np.random.PCG64(child)).bit_generator.state == rngs[name].bit_generator.state
     thresholds = TruncatedStream(scene.distribution, rngs["thresholds"]).take(2 + 7)
-    np.testing.assert_array_equal(np.concatenate([real.mu, real.mu_buf]), thresholds, strict=True)
-    np.testing.assert_array_equal(real.tmu, TruncatedStream(scene.distribution, rngs["tilt"]).take(7), strict=True)
-    np.testing.assert_array_equal(real.tu, rngs["tilt_uniforms"].random(7), strict=True)
+    np.testing.assert_array_equal(np.concatenate([real.mu, real.buffers.mu]), thresholds, strict=True)
+    np.testing.assert_array_equal(real.buffers.tilt_mu, TruncatedStream(scene.distribution, rngs["tilt"]).take(7),
+                                  strict=True)
+    np.testing.assert_array_equal(real.buffers.tilt_u, rngs["tilt_uniforms"].random(7), strict=True)
 
 
 # -- the stream itself ------------------------------------------------------------------------------

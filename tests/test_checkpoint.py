@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 import pytest
 
-from slidernet import kernels
 from slidernet.config import load_config
 from slidernet.errors import CheckpointError
 from slidernet.io.checkpoint import checkpoint_info, load_realization, save_realization
@@ -103,7 +102,7 @@ def test_a_resumed_realization_gives_the_uninterrupted_bits(name: str, tmp_path:
         assert real.out["f_count"].sum() > 0
         assert real.rngs["tilt"].bit_generator.state != fresh.rngs["tilt"].bit_generator.state
     if real.scene.catalogue:
-        assert len(real.backend.event_chunks) > 0 and real.ist[kernels.EV_POS] > 0
+        assert len(real.backend.event_chunks) > 0 and real.state["ev_pos"][0] > 0
 
     # New Python objects throughout: another Scene from the same config, another SeedSequence.
     scene = fresh_scene(name)
@@ -222,9 +221,9 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     # A checkpoint with a missing array names it.
     saved_at_third("pair_tilt", tmp_path / "r.npz")
     arrays = npz_arrays(tmp_path / "r.npz")
-    del arrays["state/mu_buf"]
+    del arrays["buffers/mu"]
     np.savez(tmp_path / "partial.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"inconsistent: it has no array 'state/mu_buf'"):
+    with pytest.raises(CheckpointError, match=r"inconsistent: it has no array 'buffers/mu'"):
         load_realization(scene, ss, tmp_path / "partial.npz")
     # The surplus of a threshold stream is state: missing, or below mu_d, it is refused.
     arrays = npz_arrays(tmp_path / "r.npz")
@@ -244,13 +243,15 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     header = json.loads(arrays["header"].tobytes())
     arrays["header"] = np.frombuffer(json.dumps({**header, "version": 99}).encode(), np.uint8)
     np.savez(tmp_path / "future.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 3"):
+    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 4"):
         load_realization(scene, ss, tmp_path / "future.npz")
-    # A checkpoint of the layout before the per-kernel backends (version 2) is refused, not misread.
-    arrays["header"] = np.frombuffer(json.dumps({**header, "version": 2}).encode(), np.uint8)
-    np.savez(tmp_path / "old.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"layout version 2; this slidernet reads version 3"):
-        load_realization(scene, ss, tmp_path / "old.npz")
+    # Checkpoints of the layouts before the per-kernel backends (version 2) and before the named
+    # state (version 3: slot arrays ist and fst) are refused, not misread.
+    for old in (2, 3):
+        arrays["header"] = np.frombuffer(json.dumps({**header, "version": old}).encode(), np.uint8)
+        np.savez(tmp_path / "old.npz", **arrays)
+        with pytest.raises(CheckpointError, match=rf"layout version {old}; this slidernet reads version 4"):
+            load_realization(scene, ss, tmp_path / "old.npz")
     with pytest.raises(FileNotFoundError):
         load_realization(scene, ss, tmp_path / "missing.npz")
 

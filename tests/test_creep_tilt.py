@@ -31,26 +31,28 @@ def chain_config(n: int = 2, sigma_ratio: float = 3.0, **changes) -> dict:
 
 
 def _pair_work(N: int = 2):
-    return (np.zeros((2, N), np.int64), np.zeros((2, N)), np.zeros((N, 2), np.int64),
-            np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
+    return kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N_POS, np.int64)
+
+
+def _settings(mu_d: float, max_slips: int) -> kernels.Settings:
+    return kernels.Settings(mu_d=mu_d, max_slips=max_slips, recompute_every=0, do_tilt=False, slip_mode=0)
 
 
 def network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu):
     """tilt_test_network on a 2-node chain with spring force F on slider 2 (in N)."""
-    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_ops()
+    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_operators()
     G = np.array([[-F, 0.0], [F, 0.0]])
-    hp, hv, hpos, epoch, pos = _pair_work()
-    f = tilt_test_network(G, np.array([mu1, mu2]), np.ones(2), ops["f_ext"], ops["f_bar"], ops["indptr"],
-                          ops["indices"], ops["kblk"], ops["diagpos"], mu_d, 0, ops["pair_rule"],
-                          np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, 10_000, hp, hv, hpos,
-                          epoch)
+    heaps, epoch, pos = _pair_work()
+    f = tilt_test_network(G, np.array([mu1, mu2]), ops.f_ext, ops.f_bar, ops.net, _settings(mu_d, 10_000),
+                          ops.pair_rule, np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, heaps, epoch)
     return f, int(pos[P_MU]), int(pos[P_U])
 
 
 def pair_tilt(F, mu1, mu2, mu_d, tmu, tu):
-    ist, _ = kernels.empty_state()
-    f = kernels.tilt_test_pair(F, mu1, mu2, mu_d, np.asarray(tmu, float), np.asarray(tu, float), ist)
-    return f, int(ist[kernels.TMU_POS]), int(ist[kernels.TU_POS])
+    st = kernels.new_state()[0]
+    f = kernels.tilt_test_pair(st, kernels.Draws(np.empty(0), np.asarray(tmu, float), np.asarray(tu, float)),
+                               F, mu1, mu2, mu_d)
+    return f, int(st["tilt_mu_pos"]), int(st["tilt_u_pos"])
 
 
 @pytest.mark.parametrize(
@@ -88,12 +90,11 @@ def test_network_tilt_equals_the_appendix_on_random_states():
 
 
 def test_network_tilt_out_of_draws_asks_for_more_and_rolls_back():
-    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_ops()
-    hp, hv, hpos, epoch, pos = _pair_work()
+    ops = Scene.from_config(load_config(chain_config(2)), network=chain(2, Ntilde=1e-7)).tilt_operators()
+    heaps, epoch, pos = _pair_work()
     pos[P_MU], pos[P_U] = 3, 1
-    f = tilt_test_network(np.zeros((2, 2)), np.array([0.6, 0.9]), np.ones(2), ops["f_ext"], 0.0, ops["indptr"],
-                          ops["indices"], ops["kblk"], ops["diagpos"], 0.5, 0, True, np.full(3, 0.7),
-                          np.full(1, 0.5), pos, 100, 100, hp, hv, hpos, epoch)
+    f = tilt_test_network(np.zeros((2, 2)), np.array([0.6, 0.9]), ops.f_ext, 0.0, ops.net, _settings(0.5, 100),
+                          True, np.full(3, 0.7), np.full(1, 0.5), pos, 100, heaps, epoch)
     assert f == -1.0
     assert (pos[P_MU], pos[P_U]) == (3, 1)
 
@@ -180,14 +181,14 @@ def test_mu_eff_on_a_lattice_at_every_recorded_time(f_ext, seed, damped):
     samples, restarts = [], 0
     for child in realization_seeds(seed, 2):
         r = Realization(scene, child)
-        redraws, pos, row = r.tmu.copy(), 0, []
+        redraws, pos, row = r.buffers.tilt_mu.copy(), 0, []
         for t in ds["t"].values:
             r.advance(int(t))  # its own test at t leaves the state as it was
             f, used, again = reference_network_tilt(scene.network, r.forces(), r.thresholds, 0.5, redraws[pos:])
             pos += used
             restarts += again
             row.append(f)
-        assert r.ist[kernels.TMU_POS] == pos  # the same draws: one per slip but the last
+        assert r.state["tilt_mu_pos"][0] == pos  # the same draws: one per slip but the last
         samples.append(row)
     np.testing.assert_allclose(ds["mu_eff"].values, np.mean(samples, axis=0), rtol=1e-9, atol=0)
     assert pos > 100  # the tests made avalanches, not single slips
@@ -210,11 +211,12 @@ def test_a_tilt_test_leaves_the_state_as_it_was():
     cfg = load_config(chain_config(6, observables=[*NET_OBS, "mu_eff"]))
     r = Realization(Scene.from_config(cfg), np.random.SeedSequence(1)).advance(10)
     F, mu, u = r.forces().copy(), r.thresholds, r.displacements()
-    start = r.ist[kernels.TMU_POS]
-    expected, used, _ = reference_network_tilt(r.scene.network, F, mu, cfg.friction.mu_d, r.tmu[start:])
+    start = r.state["tilt_mu_pos"][0]
+    expected, used, _ = reference_network_tilt(r.scene.network, F, mu, cfg.friction.mu_d,
+                                               r.buffers.tilt_mu[start:])
     f = r.tilt_test()
     assert f == pytest.approx(expected, rel=1e-9)
-    assert r.ist[kernels.TMU_POS] == start + used
+    assert r.state["tilt_mu_pos"][0] == start + used
     np.testing.assert_array_equal(r.forces(), F)
     np.testing.assert_array_equal(r.thresholds, mu)
     np.testing.assert_array_equal(r.displacements(), u)
@@ -232,7 +234,7 @@ def test_a_relaxed_chain_of_equal_thresholds_slides_at_that_threshold(n):
     np.testing.assert_array_equal(r.forces(), 0.0)
     r.mu[:] = 0.62
     assert r.tilt_test() == 0.62
-    assert reference_network_tilt(r.scene.network, r.forces(), r.thresholds, 0.5, r.tmu)[0] == 0.62
+    assert reference_network_tilt(r.scene.network, r.forces(), r.thresholds, 0.5, r.buffers.tilt_mu)[0] == 0.62
 
 
 def test_mu_eff_before_every_rearrangement_needs_a_pair():

@@ -56,7 +56,7 @@ def test_the_catalogue_adds_up_to_the_records(net, small_chunks):
     assert (np.diff(ev["avalanche"]) >= 0).all()
     assert np.unique(ev["avalanche"]).size == res["n_events"]
     # The slips up to each recorded time are those with time <= t.
-    t = r.scene.rec_times
+    t = r.scene.out_steps
     np.testing.assert_array_equal(np.searchsorted(ev["time"], t, side="right"), res["n"])
 
 
@@ -123,7 +123,7 @@ def test_x_G_is_the_load_weighted_mean_of_the_catalogued_displacements(net, smal
     r = Realization(scene, np.random.SeedSequence(5)).advance()
     res, ev = r.result(), r.events()
     weight = network.normal_load / network.normal_load.sum()
-    upto = np.searchsorted(ev["time"], scene.rec_times, side="right")
+    upto = np.searchsorted(ev["time"], scene.out_steps, side="right")
     x_G = np.concatenate([[0.0], np.cumsum(weight[ev["node"]] * ev["dx"])])[upto]
     np.testing.assert_allclose(res["x_G"], x_G, rtol=1e-9, atol=1e-18)
     u = r.displacements()

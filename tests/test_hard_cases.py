@@ -28,7 +28,6 @@ from hypothesis import strategies as st
 from scipy import special, stats
 
 import slidernet
-from slidernet import kernels
 from slidernet.analysis import theory
 from slidernet.analysis.observables import assemble
 from slidernet.config import load_config
@@ -55,8 +54,8 @@ def hard_config(network: dict[str, Any], ratio: float, Ntilde: float = 1e-7, ste
 
 def force_scale(r: Realization) -> float:
     """Size of the numbers that F = a + g theta (F = theta - u for the pair) is the difference of."""
-    state = abs(float(r.fst[kernels.U])) if r.scene.kernel == "pair" else float(np.abs(r.backend.a).max())
-    return max(1.0, abs(float(r.fst[kernels.THETA])), state)
+    state = abs(float(r.state["u"][0])) if r.scene.kernel == "pair" else float(np.abs(r.backend.nodes.a).max())
+    return max(1.0, abs(float(r.state["theta"][0])), state)
 
 
 def assert_stable(r: Realization) -> None:
@@ -145,10 +144,10 @@ def test_network_results_at_decimal_Ntilde(network, steps):
     # same, n differs by the threshold noise (at most 2e-3 relative measured,
     # seeds 0-7), tolerance 1 %, while a mis-scaled theta would change n by
     # orders of magnitude. Seeds 1 and 5 give both cases.
-    ops = [scene_of(hard_config(network, 10.0, Ntilde, 1)).ops for Ntilde in [1e-7, *DECIMAL_NTILDE]]
+    ops = [scene_of(hard_config(network, 10.0, Ntilde, 1)).operators for Ntilde in [1e-7, *DECIMAL_NTILDE]]
     for other in ops[1:]:
-        for name, value in ops[0].items():
-            np.testing.assert_array_equal(other[name], value, err_msg=name)
+        for name, value in ops[0]._asdict().items():
+            np.testing.assert_array_equal(getattr(other, name), value, err_msg=name)
     same_start = []
     for seed in (1, 5):
         ref_cfg = hard_config(network, 10.0, 1e-7, steps)
@@ -208,7 +207,7 @@ def test_networks_at_sigma_theta_1e4_stay_stable_and_finite(network, steps):
     assert r.n > 1_000_000
     for name in ("mu_max", "x_G", "mu_min", "mu_mean"):
         assert np.isfinite(res[name]).all(), name
-    assert np.isfinite(r.backend.u).all() and np.isfinite(r.backend.a).all()
+    assert np.isfinite(r.backend.nodes.u).all() and np.isfinite(r.backend.nodes.a).all()
 
 
 # --------------------------------------------------------------------------
@@ -249,7 +248,7 @@ def test_no_threshold_ever_at_or_below_mu_d(network, mean, std):
     for q in range(1, 31):
         r.advance(q)
         assert r.thresholds.min() > MU_D
-        assert r.mu_buf.min() > MU_D
+        assert r.buffers.mu.min() > MU_D
         assert_stable(r)
     assert r.n > 1000
     res = r.result()
@@ -303,7 +302,7 @@ def test_slips_at_mu_s_next_to_mu_d_are_tiny_positive_and_leave_a_stable_state(n
     tiny = du < 1e-9
     assert tiny.sum() > 0.1 * r.n  # the case is exercised: ~1/4 of the draws
     if r.scene.kernel == "csr":
-        bound = 2 * (NEAR - MU_D) / r.scene.ops["kdiag"][ev["node"]]
+        bound = 2 * (NEAR - MU_D) / r.scene.operators.K_diag[ev["node"]]
         assert (du >= bound).all()
         assert du.min() == 2 * (NEAR - MU_D)
 
@@ -444,7 +443,7 @@ def relaxation_order(network: dict[str, Any], bumps: dict[int, float],
     cfg = hard_config(network, 1.0, steps=1, observables=["n", "events"])
     cfg["friction"]["static"] = threshold_file
     r = realization_of(cfg, 0)
-    u = r.backend.u.reshape(r.mu.size, -1)
+    u = r.backend.nodes.u.reshape(r.mu.size, -1)
     for node, b in bumps.items():
         u[node, 0] = b
     r.recompute_forces()
@@ -496,9 +495,9 @@ def test_counts_past_2_31_survive_into_the_dataset_and_netcdf(network, tmp_path)
         records = []
         for seed_seq in np.random.SeedSequence(7).spawn(2):
             r = Realization(scene, seed_seq)
-            r.ist[kernels.N_SLIPS] = start
+            r.state["n_slips"][0] = start
             records.append(r.advance().result())
-        return assemble(records, scene.rec_times, list(cfg.observables), {"seed": "7"})
+        return assemble(records, scene.out_steps, list(cfg.observables), {"seed": "7"})
 
     plain, shifted = dataset(0), dataset(START)
     assert shifted["n"].dtype == np.int64
@@ -592,7 +591,7 @@ def test_1e9_rearrangements_in_one_realization():
     assert n >= 1_000_000_000
     # Exact bookkeeping: one draw per slip, none lost or taken twice; mu_max is
     # the largest draw so far and n_records the records among the draws.
-    unused = r.draws["thresholds"].surplus.size + r.mu_buf.size - int(r.ist[kernels.MU_POS])
+    unused = r.draws["thresholds"].surplus.size + r.buffers.mu.size - int(r.state["mu_pos"][0])
     used, top, records = counted.used(unused)
     assert used == n
     assert res["mu_max"][-1] == top

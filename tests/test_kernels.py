@@ -29,26 +29,29 @@ MU_D = 0.5
 class PairState:
     """A hand-built two-slider state and the buffers run_pair needs."""
 
-    def __init__(self, u: float, theta: float, mu: tuple[float, float], rec_times=(0, 1)):
-        self.ist, self.fst = kernels.empty_state()
-        self.fst[kernels.U] = u
-        self.fst[kernels.THETA] = theta
-        self.fst[kernels.MU_MAX] = max(mu)
+    def __init__(self, u: float, theta: float, mu: tuple[float, float], out_steps=(0, 1)):
+        self.state = kernels.new_state()
+        self.st = self.state[0]
+        self.st["u"] = u
+        self.st["theta"] = theta
+        self.st["mu_max"] = max(mu)
         self.mu = np.array(mu, dtype=float)
-        self.rec_times = np.asarray(rec_times, dtype=np.int64)
-        T = self.rec_times.size
-        self.out = [np.zeros(T, np.int64), np.zeros(T), np.zeros(T), np.zeros(T, np.int64),
-                    np.zeros(T), np.zeros(T), np.zeros(T, np.int64)]
+        self.out_steps = np.asarray(out_steps, dtype=np.int64)
+        T = self.out_steps.size
+        nothing = np.empty(0)
+        self.out = kernels.Series(n=np.zeros(T, np.int64), mu_max=np.zeros(T), x_G=np.zeros(T),
+                                  n_records=np.zeros(T, np.int64), mu_mean=nothing, mu_min=nothing, y_G=nothing,
+                                  f_sum=np.zeros(T), f_sq=np.zeros(T), f_count=np.zeros(T, np.int64))
 
     def run(self, thetas, mu_buf, mu_d: float = MU_D) -> int:
-        return kernels.run_pair(
-            np.asarray(thetas, dtype=float), self.rec_times, self.mu, self.ist, self.fst,
-            np.asarray(mu_buf, dtype=float), np.empty(0), np.empty(0), mu_d, False, 1000, *self.out,
-        )
+        draws = kernels.Draws(np.asarray(mu_buf, dtype=float), np.empty(0), np.empty(0))
+        settings = kernels.Settings(mu_d=mu_d, max_slips=1000, recompute_every=0, do_tilt=False, slip_mode=0)
+        return kernels.run_pair(np.asarray(thetas, dtype=float), self.out_steps, self.mu, self.state, draws,
+                                self.out, settings)
 
     @property
     def n(self) -> int:
-        return int(self.ist[kernels.N_SLIPS])
+        return int(self.st["n_slips"])
 
 
 # (mu_s,1, mu_s,2) with slider 1 or slider 2 the weaker one.
@@ -69,15 +72,15 @@ def test_single_slip_follows_eq_displacement(mu, s):
     status = st.run([u0, theta_c + 0.05 * s], mu_buf=[0.6])
     assert status == kernels.DONE
     assert st.n == 1
-    assert st.fst[kernels.U] == pytest.approx(u0 + 2 * (mu_min - MU_D) * s, abs=1e-14)
+    assert st.st["u"] == pytest.approx(u0 + 2 * (mu_min - MU_D) * s, abs=1e-14)
     # eq. `displacmt-G`: half the slip, sign (-1)^i s.
-    assert st.fst[kernels.XG] == pytest.approx((-1) ** i * (mu_min - MU_D) * s, abs=1e-14)
+    assert st.st["x_G"] == pytest.approx((-1) ** i * (mu_min - MU_D) * s, abs=1e-14)
     # Only the weakest threshold is redrawn (it takes the first buffer value).
     expected = list(mu)
     expected[i - 1] = 0.6
     assert st.mu.tolist() == expected
-    assert st.fst[kernels.MU_MAX] == max(expected)
-    assert st.ist[kernels.N_EVENTS] == 1
+    assert st.st["mu_max"] == max(expected)
+    assert st.st["n_events"] == 1
 
 
 @pytest.mark.parametrize("s", [1.0, -1.0], ids=["dilating", "contracting"])
@@ -90,7 +93,7 @@ def test_rearrangement_happens_at_theta_c(mu, s):
     # before the slip, which exposes the theta it found.
     st = PairState(u=u0, theta=theta0, mu=mu)
     assert st.run([theta0, theta_c + 0.05 * s], mu_buf=[]) == kernels.NEED_MU
-    assert st.fst[kernels.THETA] == theta_c
+    assert st.st["theta"] == theta_c
     assert st.n == 0
     # Resuming from that clean point completes the slip.
     assert st.run([theta0, theta_c + 0.05 * s], mu_buf=[0.6]) == kernels.DONE
@@ -109,7 +112,7 @@ def test_theta_c_is_the_exact_threshold(s):
     st = PairState(u=u0, theta=u0, mu=WEAK1)
     st.run([u0, math.nextafter(theta_c, u0)], mu_buf=[0.6])
     assert st.n == 0
-    assert st.fst[kernels.U] == u0
+    assert st.st["u"] == u0
 
 
 def test_no_rearrangement_while_theta_is_constant():
@@ -126,11 +129,11 @@ def test_avalanche_slips_the_most_overloaded_until_stable():
     st = PairState(u=0.0, theta=0.0, mu=(1.9, 2.5))
     st.run([0.0, 1.95], mu_buf=[0.55, 0.7], mu_d=MU_D)
     assert st.n == 2
-    assert st.ist[kernels.N_EVENTS] == 1
+    assert st.st["n_events"] == 1
     F = 1.9 - 2 * (1.9 - MU_D)  # = -0.9 after the driving slip
     F = F - 2 * (abs(F) - MU_D) * np.sign(F)  # = 0.1 after the avalanche slip
     # theta ended at 1.95 (past 1.9): F grew by 0.05 after the avalanche.
-    assert 1.95 - st.fst[kernels.U] == pytest.approx(F + 0.05, abs=1e-12)
+    assert 1.95 - st.st["u"] == pytest.approx(F + 0.05, abs=1e-12)
     assert st.mu.tolist() == [0.7, 2.5]
 
 
@@ -163,7 +166,7 @@ def test_realization_single_slip(fixed_driver, s, seed):
     mu_min = mu0.min()
     assert real.x_G == pytest.approx((-1) ** i * (mu_min - MU_D) * ntilde * s, rel=1e-12)
     assert res["x_G"][-1] == real.x_G
-    assert real.fst[kernels.U] * ntilde == pytest.approx(2 * (mu_min - MU_D) * ntilde * s, rel=1e-12)
+    assert real.state["u"][0] * ntilde == pytest.approx(2 * (mu_min - MU_D) * ntilde * s, rel=1e-12)
     after = real.thresholds
     assert after[2 - i] == mu0[2 - i]  # the stronger one is untouched
     assert after[i - 1] == first_redraw
@@ -211,9 +214,10 @@ def tilt_reference(F, mu1, mu2, mu_d, tmu, tu):
 
 
 def run_tilt(F, mu1, mu2, mu_d, tmu, tu):
-    ist, _ = kernels.empty_state()
-    f = kernels.tilt_test_pair(F, mu1, mu2, mu_d, np.asarray(tmu, float), np.asarray(tu, float), ist)
-    return f, int(ist[kernels.TMU_POS]), int(ist[kernels.TU_POS])
+    st = kernels.new_state()[0]
+    f = kernels.tilt_test_pair(st, kernels.Draws(np.empty(0), np.asarray(tmu, float), np.asarray(tu, float)),
+                               F, mu1, mu2, mu_d)
+    return f, int(st["tilt_mu_pos"]), int(st["tilt_u_pos"])
 
 
 def test_tilt_immediate_sliding():
@@ -252,20 +256,21 @@ def test_tilt_slider2_rearranges():
 
 def test_tilt_out_of_draws_rolls_back():
     # Needs one threshold draw and none is there: -1, read positions untouched.
-    ist, _ = kernels.empty_state()
-    ist[kernels.TMU_POS] = 3
-    ist[kernels.TU_POS] = 2
-    f = kernels.tilt_test_pair(0.0, 0.6, 0.9, 0.5, np.full(3, 0.7), np.full(2, 0.5), ist)
+    st = kernels.new_state()[0]
+    st["tilt_mu_pos"] = 3
+    st["tilt_u_pos"] = 2
+    draws = kernels.Draws(np.empty(0), np.full(3, 0.7), np.full(2, 0.5))
+    f = kernels.tilt_test_pair(st, draws, 0.0, 0.6, 0.9, 0.5)
     assert f == -1.0
-    assert (ist[kernels.TMU_POS], ist[kernels.TU_POS]) == (3, 2)
+    assert (st["tilt_mu_pos"], st["tilt_u_pos"]) == (3, 2)
 
 
 def test_tilt_iteration_cap():
     # Thresholds exactly at mu_d and F redrawn at the centre give f = mu_d
     # forever (creep without end): the kernel gives up with -2.
     m = kernels.TILT_MAX_ITER
-    f = kernels.tilt_test_pair(0.0, 0.5, 0.5, 0.5, np.full(2 * m + 2, 0.5), np.full(m + 1, 0.5),
-                               kernels.empty_state()[0])
+    f = kernels.tilt_test_pair(kernels.new_state()[0], kernels.Draws(np.empty(0), np.full(2 * m + 2, 0.5),
+                                                                      np.full(m + 1, 0.5)), 0.0, 0.5, 0.5, 0.5)
     assert f == -2.0
 
 
@@ -420,4 +425,4 @@ def test_realization_draws_follow_the_documented_streams():
     np.testing.assert_array_equal(real.thetas,
                                   real.scene.driver.thetas(rngs["driver"], 10) / real.scene.network.Ntilde)
     np.testing.assert_array_equal(real.mu, dist.sample(rngs["thresholds"], 2))
-    np.testing.assert_array_equal(real.mu_buf, dist.sample(rngs["thresholds"], 32))
+    np.testing.assert_array_equal(real.buffers.mu, dist.sample(rngs["thresholds"], 32))

@@ -101,20 +101,20 @@ def slip_by_slip(real: Realization):
     each slip, (thresholds before, thresholds after, u before, u after,
     x_G before, x_G after, new avalanche?) in internal units.
     """
-    queue = list(real.mu_buf)
-    ist, fst = real.ist, real.fst
+    queue = list(real.buffers.mu)
+    st = real.state[0]
     while True:
         if not queue:
             queue = list(real.draws["thresholds"].take(real.scene.batch))
-        real.mu_buf = np.array(queue[:1])
-        ist[kernels.MU_POS] = 0
-        before = (real.thresholds, fst[kernels.U], fst[kernels.XG], int(ist[kernels.N_EVENTS]))
+        real.buffers = real.buffers._replace(mu=np.array(queue[:1]))
+        st["mu_pos"] = 0
+        before = (real.thresholds, float(st["u"]), float(st["x_G"]), int(st["n_events"]))
         status = real.backend.run(real, real.thetas)
-        assert status == kernels.DONE or ist[kernels.MU_POS] == 1  # else no progress
-        if ist[kernels.MU_POS] == 1:
+        assert status == kernels.DONE or st["mu_pos"] == 1  # else no progress
+        if st["mu_pos"] == 1:
             queue.pop(0)
-            yield (before[0], real.thresholds, before[1], fst[kernels.U], before[2], fst[kernels.XG],
-                   int(ist[kernels.N_EVENTS]) > before[3])
+            yield (before[0], real.thresholds, before[1], float(st["u"]), before[2], float(st["x_G"]),
+                   int(st["n_events"]) > before[3])
         if status == kernels.DONE:
             return
         assert status == kernels.NEED_MU
@@ -146,12 +146,12 @@ def test_x_G_moves_by_half_the_slip(seed, phys):
         half_signed += sign * du / 2
         changes += int(np.argmax(mu1) != np.argmax(mu0))
     assert real.n == n
-    np.testing.assert_allclose(real.fst[kernels.XG], half_signed, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(real.state["x_G"][0], half_signed, rtol=1e-9, atol=1e-9)
     # Interrupting the kernel after every slip changes nothing: same bits as one run.
     ref = simulate(real.scene, np.random.SeedSequence(seed))
     assert ref["n"][-1] == n
     assert ref["x_G"][-1] == real.result()["x_G"][-1]
-    assert ref["mu_max"][-1] == real.fst[kernels.MU_MAX]
+    assert ref["mu_max"][-1] == real.state["mu_max"][0]
     # Every change of the strongest slider is a record among the draws.
     assert ref["n_records"][-1] == changes
 
@@ -168,9 +168,9 @@ def test_single_slip_steps_move_x_G_by_mu_minus_mu_d(seed, phys):
     single = 0
     for q in range(1, 61):
         mu_before, n_before, x_before = real.thresholds, real.n, real.x_G
-        events_before = int(real.ist[kernels.N_EVENTS])
+        events_before = int(real.state["n_events"][0])
         real.advance(q)
-        if real.n - n_before == 1 and real.ist[kernels.N_EVENTS] - events_before == 1:
+        if real.n - n_before == 1 and real.state["n_events"][0] - events_before == 1:
             i = int(np.argmin(mu_before))  # 0: slider 1
             s = np.sign(thetas[q] - thetas[q - 1])
             expected = (-1) ** (i + 1) * s * (mu_before[i] - mu_d) * ntilde

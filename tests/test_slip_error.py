@@ -2,7 +2,7 @@
 
 * The straight-line slip is exact where K_ii is isotropic, and along either
   eigen-axis of an anisotropic K_ii; the benchmark's reference integrator and
-  ``slidernet.kernels.vec.exact_slip`` both reproduce it there.
+  ``slidernet.kernels.plane.exact_slip`` both reproduce it there.
 * The reference integrator is converged and ends with the node stuck:
   |F_after| <= mu_d N, hence also <= |F_before|.
 * Its run statistics are the ones ``slidernet.run`` reports.
@@ -26,7 +26,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import slidernet
-from slidernet.kernels.vec import exact_slip
+from slidernet.kernels.plane import exact_slip
 
 MU_D = 0.5  # kinetic friction mu_d N with N = 1, in N
 REL = 1e-9  # agreement where the straight line is exact (both integrators reach ~1e-12 there)

@@ -29,7 +29,7 @@ def test_horizontal_draws_are_the_solvers():
     r = Realization(scene, ss)
     np.testing.assert_array_equal(thetas, r.thetas)
     np.testing.assert_array_equal(mu, r.mu)
-    np.testing.assert_array_equal(next(batches), r.mu_buf)
+    np.testing.assert_array_equal(next(batches), r.buffers.mu)
 
 
 def test_fixed_step_converges_to_the_exact_solution(pair40):

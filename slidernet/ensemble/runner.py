@@ -171,8 +171,8 @@ def run(
         raise
     attrs = _attrs(cfg, scene.kernel, workers, scheduler)
     if store is None:
-        return assemble((records.pop(r) for r in range(R)), scene.rec_times, list(cfg.observables), attrs)
-    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.rec_times, R,
+        return assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
+    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
                                list(cfg.observables), attrs)
     store.remove()
     return xr.open_dataset(path, engine="netcdf4")

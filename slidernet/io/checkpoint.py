@@ -20,9 +20,14 @@ File layout (keys of the ``.npz``; every array numeric):
     of theta(t_q)), ``rngs`` (the ``bit_generator.state`` of the driver,
     thresholds, tilt and tilt_uniforms streams), ``step`` and ``n`` (for information),
     ``tilted`` and ``numpy``.
-``state/<name>``
-    The arrays every realization has: ``ist``, ``fst``, ``mu``, ``mu_buf``,
-    ``tmu``, ``tu``.
+``state/<field>``
+    The realization's scalars, one 0-d array per field of
+    :data:`slidernet.kernels.STATE` (``q``, ``n_slips``, ``theta``, ...), version 4 on.
+``mu``
+    The thresholds mu_s of the nodes.
+``buffers/<name>``
+    The draws waiting for the kernel (:class:`slidernet.kernels.Draws`):
+    ``mu``, ``tilt_mu``, ``tilt_u`` (version 4 on).
 ``surplus/<name>``
     float64, the surplus of the ``thresholds`` and ``tilt`` threshold
     streams (``Realization.draws``), in order (version 2 on).
@@ -31,11 +36,13 @@ File layout (keys of the ``.npz``; every array numeric):
 ``backend/<name>``
     The kernel's own state, as its backend writes and reads it
     (:mod:`slidernet.solver.backends`, version 3 on): nothing for the pair
-    kernel; for the network kernels ``a``, ``u``, ``hp``, ``hpos``, ``hv``,
-    ``aval_hist``, ``node_slips``, the catalogue rows in the kernel's buffer
-    (``events/buffer_i``, ``events/buffer_f``: its first ``ist[EV_POS]``
-    rows; ``events/buffer_rows``, its size), the chunks already handed to
-    Python (``events/chunks_i``, ``events/chunks_f``, ``events/chunk_rows``)
+    kernel; for the network kernels the per-node state (``nodes/a``,
+    ``nodes/u``, ``nodes/node_slips``, ``nodes/avalanche_count``), the heaps
+    (``heaps/node``, ``heaps/key``, ``heaps/slot``, ``heaps/size``), the
+    catalogue rows in the kernel's buffer (``events/buffer_ids``,
+    ``events/buffer_values``: its first ``ev_pos`` rows;
+    ``events/buffer_rows``, its size), the chunks already handed to Python
+    (``events/chunks_ids``, ``events/chunks_values``, ``events/chunk_rows``)
     and ``events/complete``.
 """
 
@@ -50,6 +57,7 @@ from typing import Any
 
 import numpy as np
 
+from slidernet import kernels
 from slidernet.errors import CheckpointError
 from slidernet.io import atomic_output
 from slidernet.solver import Realization, Scene
@@ -57,17 +65,15 @@ from slidernet.solver import Realization, Scene
 FORMAT = "slidernet-checkpoint"
 # 2: the threshold streams' surplus (surplus/<name>) and the tilt_uniforms stream.
 # 3: the kernel's own state under backend/<name>, written and read by its backend.
-VERSION = 3
+# 4: named state (state/<field>, buffers/<name>, the backend's nodes/ and heaps/).
+VERSION = 4
 
-# Arrays whose shape and dtype are fixed by the scene: copied into the fresh realization's own.
-_FIXED = ("ist", "fst", "mu")
-# Draw buffers: their length changes when they are refilled.
-_BUFFERS = ("mu_buf", "tmu", "tu")
-# Attributes written to the file by name (arrays above, or special handling below).
-_SAVED = {*_FIXED, *_BUFFERS, "out", "rngs", "draws", "backend", "_tilted"}
+# Attributes written to the file (by name, or with special handling below).
+_SAVED = {"state", "mu", "buffers", "out", "rngs", "draws", "backend", "_tilted"}
 # Attributes the constructor rebuilds, and why that is exact.
 _REBUILT = {
     "scene": "passed to load_realization",
+    "series": "the kernels' view of out: the same arrays, restored in place",
     "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
     "_mu_batches": "a generator reading draws['thresholds'], whose surplus and Generator are restored in place",
     "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
@@ -144,8 +150,11 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
     except (TypeError, ValueError) as exc:
         raise CheckpointError(f"The checkpoint meta must be JSON-serializable: {exc}.") from None
     arrays = {"header": np.frombuffer(text.encode("utf-8"), dtype=np.uint8)}
-    for name in _FIXED + _BUFFERS:
-        arrays[f"state/{name}"] = getattr(real, name)
+    for name in kernels.STATE.names:
+        arrays[f"state/{name}"] = real.state[name][0]
+    arrays["mu"] = real.mu
+    for name, values in real.buffers._asdict().items():
+        arrays[f"buffers/{name}"] = values
     for name, values in real.backend.to_arrays(real).items():
         arrays[f"backend/{name}"] = np.asarray(values)
     for name, stream in real.draws.items():
@@ -257,7 +266,8 @@ def _read(path: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     if header.get("version") != VERSION:
         raise CheckpointError(
             f"The checkpoint {str(path)!r} has layout version {header.get('version')!r}; "
-            f"this slidernet reads version {VERSION}."
+            f"this slidernet reads version {VERSION}. Finish that run with the slidernet that wrote it, "
+            "or start it again (--overwrite)."
         )
     return header, arrays
 
@@ -303,7 +313,7 @@ def _fingerprint(scene: Scene) -> dict[str, Any]:
         "Ntilde": float(net.Ntilde),
         "mu_d": float(scene.mu_d),
         "steps": int(scene.steps),
-        "rec_times": _digest(scene.rec_times),
+        "out_steps": _digest(scene.out_steps),
         "tilt_at": scene.tilt_at,
         "catalogue": bool(scene.catalogue),
         "max_events": int(scene.max_events),
@@ -314,7 +324,7 @@ def _fingerprint(scene: Scene) -> dict[str, Any]:
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": _digest(K.indptr, K.indices, K.data),
-        "loads": _digest(scene.ops["g"], net.normal_load, net.f_ext),
+        "loads": _digest(scene.operators.g, net.normal_load, net.f_ext),
     }
 
 
@@ -345,11 +355,11 @@ def _take(arrays: dict[str, np.ndarray], key: str, like: np.ndarray | None = Non
 def _restore(real: Realization, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
     """Overwrite the state of a freshly constructed ``real`` (same scene and seed) from a checkpoint."""
     # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
-    for name in _FIXED:
-        target = getattr(real, name)
-        target[...] = _take(arrays, f"state/{name}", target)
-    for name in _BUFFERS:
-        setattr(real, name, np.array(_take(arrays, f"state/{name}", dtype=np.float64, ndim=1), order="C"))
+    for name in kernels.STATE.names:
+        real.state[name] = _take(arrays, f"state/{name}", dtype=kernels.STATE[name], ndim=0)
+    real.mu[...] = _take(arrays, "mu", real.mu)
+    real.buffers = kernels.Draws(*(np.array(_take(arrays, f"buffers/{name}", dtype=np.float64, ndim=1), order="C")
+                                   for name in kernels.Draws._fields))
     saved_out = {key.removeprefix("out/") for key in arrays if key.startswith("out/")}
     if saved_out != set(real.out):
         raise ValueError(f"its records are {sorted(saved_out)}, this scene's are {sorted(real.out)}")

@@ -9,26 +9,72 @@ Delta u = 2 (mu_min - mu_d) s.
 "Model only what a scene needs":
 
 * :func:`run_pair` (``pair.py``) -- the paper's two sliders: scalars only;
-* :func:`run_csr` (``csr.py``) -- any 1D network: CSR neighbour lists;
-* :func:`run_vec` (``vec.py``) -- any 2D network: 2x2 blocks of K, vector forces.
+* :func:`run_network` (``network.py``) -- any network, one driving loop
+  compiled for each geometry: 1D (``chain.py``: scalar forces, CSR rows of
+  K) and 2D (``plane.py``: vector forces, 2x2 blocks of K).
 
-The network kernels find the next driving event from two indexed heaps
+The network kernel finds the next driving event from two indexed heaps
 keyed by each driven node's critical theta (one per direction of theta),
-and relax avalanches from a heap keyed by overload (``heap.py``); a slip
+and relaxes avalanches from a heap keyed by overload (``heap.py``); a slip
 updates only the slipped node and its neighbours, O(degree log N).
 
-On a 2-node chain ``run_csr`` performs the *same floating-point operations*
-as ``run_pair``, so the two agree to the bit (tested). All state lives in
-arrays (``state.py`` lists the slots); a kernel returns at a clean point
-when a buffer of random draws runs low, so that Python can refill it with
-the plugin's ``sample`` in batches.
+On a 2-node chain ``run_network`` performs the *same floating-point
+operations* as ``run_pair``, so the two agree to the bit (tested). All
+state lives in arrays (``state.py`` names them); a kernel returns at a clean
+point when a buffer of random draws runs low, so that Python can refill it
+with the plugin's ``sample`` in batches.
 """
 
-from slidernet.kernels.csr import init_csr_heaps, run_csr
+from slidernet.kernels.chain import init_chain_heaps, run_chain
 from slidernet.kernels.pair import run_pair
-from slidernet.kernels.state import *  # noqa: F403 - the slot and status constants
-from slidernet.kernels.state import empty_state
+from slidernet.kernels.plane import init_plane_heaps, run_plane
+from slidernet.kernels.state import (
+    AVALANCHE_LIMIT,
+    DONE,
+    N_AVALANCHE_BINS,
+    NEED_EVENTS,
+    NEED_MU,
+    NEED_TILT,
+    RECOMPUTE,
+    STATE,
+    TILT_LIMIT,
+    TILT_MAX_ITER,
+    Catalogue,
+    Chain,
+    Draws,
+    Heaps,
+    Nodes,
+    Plane,
+    Series,
+    Settings,
+    new_state,
+)
 from slidernet.kernels.tilt import tilt_test_pair
-from slidernet.kernels.vec import init_vec_heaps, run_vec
 
-__all__ = ["empty_state", "init_csr_heaps", "init_vec_heaps", "run_csr", "run_pair", "run_vec", "tilt_test_pair"]
+__all__ = [
+    "AVALANCHE_LIMIT",
+    "DONE",
+    "NEED_EVENTS",
+    "NEED_MU",
+    "NEED_TILT",
+    "N_AVALANCHE_BINS",
+    "RECOMPUTE",
+    "STATE",
+    "TILT_LIMIT",
+    "TILT_MAX_ITER",
+    "Catalogue",
+    "Chain",
+    "Draws",
+    "Heaps",
+    "Nodes",
+    "Plane",
+    "Series",
+    "Settings",
+    "init_chain_heaps",
+    "init_plane_heaps",
+    "new_state",
+    "run_chain",
+    "run_pair",
+    "run_plane",
+    "tilt_test_pair",
+]

@@ -1,14 +1,26 @@
-"""Layout of the kernels' state arrays and return codes.
+"""The kernels' state, named: one record of scalars and named groups of arrays.
 
-A kernel's whole state lives in two arrays, ``ist`` (int64) and ``fst``
-(float64), plus the per-node arrays, so that a kernel can stop at any clean
-point and resume later (buffer refills, checkpoints).
+A kernel's whole state lives in arrays it is given, so that it can stop at
+any clean point and resume later (buffer refills, checkpoints):
+
+* the scalars of a realization (counters, theta, x_G, ...) in one record of
+  the structured dtype :data:`STATE` (a 1-element array, see
+  :func:`new_state`; the kernels write its fields through ``state[0]``);
+* the arrays in named tuples: :class:`Heaps`, :class:`Draws`,
+  :class:`Series`, :class:`Catalogue`, :class:`Nodes`, and the network
+  operators :class:`Chain` (1D) and :class:`Plane` (2D), with the run's
+  constants in :class:`Settings`.
+
+numba compiles a field of a record or of a named tuple to a load at a fixed
+offset, as it does a slot of an array: the names cost nothing
+(``benchmarks/ab_kernel_state.py`` measures it).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -72,62 +84,156 @@ def cached_jit(**options) -> Callable:
 
 # Return codes.
 DONE = 0
-NEED_MU = 1  # the horizontal threshold buffer is empty
+NEED_MU = 1  # the threshold buffer (Draws.mu) is empty
 NEED_TILT = 2  # the tilt-test buffers ran out during a test (rolled back)
 AVALANCHE_LIMIT = 3  # an avalanche exceeded max_slips
 TILT_LIMIT = 4  # a tilt test exceeded its iteration cap
 RECOMPUTE = 5  # time to recompute the forces from the displacements (drift control)
 NEED_EVENTS = 6  # the event catalogue's buffer is full
 
-# Integer state (ist) slots.
-Q = 0  # next thermal step: the segment thetas[q] -> thetas[q+1]
-N_SLIPS = 1  # cumulative rearrangements n
-REC = 2  # index of the next record time
-MU_POS = 3  # read position in the threshold buffer
-TMU_POS = 4  # read position in the tilt-test threshold buffer
-TU_POS = 5  # read position in the tilt-test uniform buffer
-N_RECORDS = 6  # draws that exceeded the running mu_max
-ARGMAX = 7  # node holding mu_max
-ERR_NODE = 8  # node named by an error
-AV_SLIPS = 9  # slips in the current avalanche
-HEAP_SIZE = 10  # size of the unstable-node heap (pair: 1 while a slider is unstable)
-N_EVENTS = 11  # driving events (= avalanches)
-STARTED = 12  # 1 once the t = 0 record is written
-UP_SIZE = 13  # size of the heap of upper critical thetas (driving with theta increasing)
-DOWN_SIZE = 14  # size of the heap of lower critical thetas (theta decreasing)
-SINCE_RECOMPUTE = 15  # slips since the forces were last recomputed from u
-IN_AVALANCHE = 16  # 1 between a driving slip and the end of its avalanche
-EV_POS = 17  # events written to the catalogue buffer
-EV_ON = 18  # 1 while the event catalogue is recorded
-N_IST = 19
-
+TILT_MAX_ITER = 1_000_000
 N_AVALANCHE_BINS = 63  # avalanche sizes s are binned by floor(log2 s); 2**62 fits in int64
 
-# Float state (fst) slots.
-THETA = 0  # current theta / Ntilde
-XG = 1  # centre-of-mass displacement / (Ntilde l0)
-MU_MAX = 2  # largest threshold mu_s
-U = 3  # run_pair only: the paper's u / Ntilde (spring length change)
-YG = 4  # run_vec only: centre-of-mass displacement along y / (Ntilde l0)
-EV_T = 5  # time of the current driving event, in tau_th (q + fraction of the segment)
-N_FST = 6
+#: The scalars of a realization, one record. Units are the kernels' (theta in
+#: Ntilde, lengths in Ntilde l0, see :mod:`slidernet.kernels`).
+STATE = np.dtype([
+    # counters
+    ("q", np.int64),  # next thermal step: the segment thetas[q] -> thetas[q + 1]
+    ("n_slips", np.int64),  # cumulative rearrangements n
+    ("n_records", np.int64),  # drawn thresholds that exceeded the running mu_max
+    ("n_events", np.int64),  # driving events (= avalanches)
+    ("next_out", np.int64),  # index of the next output step (out_steps) to write
+    ("started", np.int64),  # 1 once t = 0 is closed (its initial relaxation done)
+    # read positions in the draw buffers (Draws)
+    ("mu_pos", np.int64),
+    ("tilt_mu_pos", np.int64),
+    ("tilt_u_pos", np.int64),
+    # avalanches
+    ("av_slips", np.int64),  # slips of the current avalanche after its driving slip
+    ("in_avalanche", np.int64),  # 1 between a driving slip and the end of its avalanche
+    ("pending", np.int64),  # pair kernel: 1 while a slip has left a slider over its threshold
+    ("since_recompute", np.int64),  # slips since the forces were last recomputed from u
+    ("argmax", np.int64),  # node holding mu_max
+    ("err_node", np.int64),  # node named by an error return
+    # the event catalogue
+    ("ev_pos", np.int64),  # rows written to the catalogue's buffer
+    ("ev_on", np.int64),  # 1 while the catalogue is recorded
+    # physical scalars
+    ("theta", np.float64),  # theta / Ntilde
+    ("u", np.float64),  # pair kernel: the paper's u / Ntilde (the spring's length change)
+    ("x_G", np.float64),  # centre-of-mass displacement along x / (Ntilde l0)
+    ("y_G", np.float64),  # 2D kernel: the same along y
+    ("mu_max", np.float64),  # largest threshold mu_s
+    ("event_time", np.float64),  # time of the current driving event, tau_th (q + fraction of the step)
+])
 
-TILT_MAX_ITER = 1_000_000
+
+def new_state() -> np.ndarray:
+    """A zeroed state: a 1-element array of dtype :data:`STATE` (the kernels take the array)."""
+    return np.zeros(1, dtype=STATE)
 
 
+# The three heaps of a network kernel (rows of Heaps.node / Heaps.key).
+UNSTABLE = 0  # unstable nodes keyed by their overload |F_i| / (mu_s,i N_i)
+UP = 1  # driven nodes keyed by minus their upper critical theta (next event as theta rises)
+DOWN = 2  # driven nodes keyed by their lower critical theta (next event as theta falls)
 
 
-def empty_state() -> tuple[np.ndarray, np.ndarray]:
-    """Fresh (ist, fst) arrays."""
-    return np.zeros(N_IST, dtype=np.int64), np.zeros(N_FST, dtype=np.float64)
+class Heaps(NamedTuple):
+    """Indexed binary heaps (see :mod:`slidernet.kernels.heap`), W of them over N nodes.
+
+    ``node[w, h]`` is the node in slot h of heap w and ``key[w, h]`` its key,
+    so that sifting reads contiguous memory; ``slot[node, w]`` is its slot or
+    -1, node-major so that the W slots of a node share a cache line;
+    ``size[w]`` is the size of heap w.
+    """
+
+    node: np.ndarray  # (W, N) int64
+    key: np.ndarray  # (W, N) float64
+    slot: np.ndarray  # (N, W) int64
+    size: np.ndarray  # (W,) int64
+
+    @classmethod
+    def empty(cls, n_heaps: int, n_nodes: int) -> Heaps:
+        return cls(np.zeros((n_heaps, n_nodes), np.int64), np.zeros((n_heaps, n_nodes)),
+                   np.full((n_nodes, n_heaps), -1, np.int64), np.zeros(n_heaps, np.int64))
 
 
-@kernel_jit()
-def write_record(ist, fst, out_n, out_mu_max, out_xg, out_records):
-    """Write the counters into record slot ``ist[REC]`` and advance it."""
-    k = ist[REC]
-    out_n[k] = ist[N_SLIPS]
-    out_mu_max[k] = fst[MU_MAX]
-    out_xg[k] = fst[XG]
-    out_records[k] = ist[N_RECORDS]
-    ist[REC] = k + 1
+class Draws(NamedTuple):
+    """The random draws waiting for the kernel, read from the positions ``*_pos`` of the state."""
+
+    mu: np.ndarray  # thresholds mu_s handed out one per slip
+    tilt_mu: np.ndarray  # thresholds redrawn by the appendix's tilt test
+    tilt_u: np.ndarray  # uniforms in [0, 1) of the tilt test's creep branch
+
+
+class Series(NamedTuple):
+    """What the kernels write at the output steps, one entry per step of ``out_steps``, shape (T,).
+
+    A kernel leaves out what its scene has not (0-length arrays): the pair
+    kernel ``mu_mean``, ``mu_min``, ``y_G``; the 1D kernel ``y_G``.
+    """
+
+    n: np.ndarray  # int64, cumulative rearrangements
+    mu_max: np.ndarray
+    x_G: np.ndarray  # Ntilde l0
+    n_records: np.ndarray  # int64
+    mu_mean: np.ndarray
+    mu_min: np.ndarray
+    y_G: np.ndarray  # Ntilde l0
+    f_sum: np.ndarray  # the tilt test's samples in the bin ending at the step: sum,
+    f_sq: np.ndarray  # sum of squares,
+    f_count: np.ndarray  # and count (int64)
+
+
+class Catalogue(NamedTuple):
+    """The event catalogue's buffer: one row per slip (see :func:`slidernet.kernels.heap.log_event`)."""
+
+    ids: np.ndarray  # (rows, 2) int64: node, avalanche id
+    values: np.ndarray  # (rows, 3) float64: time in tau_th, du_x, du_y in Ntilde l0
+
+
+class Nodes(NamedTuple):
+    """The per-node state of a network realization (N nodes, d = 1 or 2)."""
+
+    a: np.ndarray  # (N,) or (N, 2): force offsets, F_i = a_i + g_i theta, in N
+    u: np.ndarray  # (N,) or (N, 2): displacements, Ntilde l0
+    mu: np.ndarray  # (N,): thresholds mu_s
+    node_slips: np.ndarray  # (N,) int64: slips of each node
+    avalanche_count: np.ndarray  # (N_AVALANCHE_BINS,) int64: avalanches by floor(log2 size)
+
+
+class Chain(NamedTuple):
+    """A 1D network's operators: the CSR rows of K and the loads."""
+
+    indptr: np.ndarray  # (N + 1,) int64
+    indices: np.ndarray  # (nnz,) int64
+    K_data: np.ndarray  # (nnz,) entries of K, in k0
+    K_diag: np.ndarray  # (N,) K_ii
+    g: np.ndarray  # (N,) thermal load: dF_i / d(theta / Ntilde), in N
+    normal_load: np.ndarray  # (N,) N_i, in N
+    w: np.ndarray  # (N,) N_i / sum N: weights of the centre of mass
+    unit_load: bool  # every N_i == 1 (the load array is then not read in the hot loop)
+
+
+class Plane(NamedTuple):
+    """A 2D network's operators: the block-CSR rows of K (2 x 2 blocks) and the loads."""
+
+    indptr: np.ndarray  # (N + 1,) int64
+    indices: np.ndarray  # (nnzb,) int64
+    K_blocks: np.ndarray  # (nnzb, 2, 2) blocks K_ij, in k0
+    diag: np.ndarray  # (N,) int64: position of K_ii in K_blocks
+    g: np.ndarray  # (N, 2) thermal load
+    normal_load: np.ndarray  # (N,)
+    w: np.ndarray  # (N,)
+    unit_load: bool
+
+
+class Settings(NamedTuple):
+    """A run's constants."""
+
+    mu_d: float  # dynamic coefficient
+    max_slips: int  # slips of one avalanche before AVALANCHE_LIMIT
+    recompute_every: int  # slips between recomputations of the forces (0: never)
+    do_tilt: bool  # the appendix's tilt test before every rearrangement (a 1D pair)
+    slip_mode: int  # 2D: SLIP_STRAIGHT (0) or SLIP_EXACT (1)

@@ -44,18 +44,18 @@ One case differs, outside the paper's parameters: the appendix never lets a
 slider slip backwards, while here a slider whose threshold drops below
 mu_s,old - 2 mu_d after its slip does (it is unstable).
 
-Work arrays are the caller's: ``hp`` (2, N) int64, ``hv`` (2, N) float64,
-``hpos`` (N, 2) int64 and ``epoch`` (N,) int64, so that a test allocates
-nothing.
+Work arrays are the caller's: two :class:`~slidernet.kernels.state.Heaps`
+over the N nodes (``Heaps.empty(2, N)``) and ``epoch`` (N,) int64, so that a
+test allocates nothing.
 """
 
 from __future__ import annotations
 
 import math
 
-from slidernet.kernels.heap import heap_set
+from slidernet.kernels.heap import heap_clear, heap_set
+from slidernet.kernels.plane import SLIP_EXACT, exact_slip, spread, straight_slip
 from slidernet.kernels.state import kernel_jit
-from slidernet.kernels.vec import SLIP_EXACT, exact_slip, straight_slip
 
 # Return codes (negative: no sample).
 TILT_NEED_DRAWS = -1.0
@@ -64,10 +64,12 @@ TILT_TOO_LONG = -2.0
 # Slots of the small integer array ``pos`` (shape (N_POS,)) shared with the caller.
 P_MU = 0  # read position in the threshold buffer
 P_U = 1  # read position in the uniform buffer
-_UNSTABLE = 2  # size slot of heap 0 (overload)
-_CRITICAL = 3  # size slot of heap 1 (critical f)
-N_SLIPS = 4  # slips made by the test (out)
-N_POS = 5
+N_SLIPS = 2  # slips made by the test (out)
+N_POS = 3
+
+# The test's two heaps.
+_UNSTABLE = 0  # unstable nodes keyed by overload
+_CRITICAL = 1  # nodes keyed by minus the tilt f at which they reach their threshold
 
 
 @kernel_jit(inline="always")
@@ -80,7 +82,7 @@ def _critical_f(Gx, Gy, lim, n):
 
 
 @kernel_jit(inline="always")
-def _key(j, f, G, mu, normal_load, hp, hv, hpos, sz):
+def _key(j, f, G, mu, normal_load, heaps):
     """Re-key node j in both heaps at tilt f; returns True if it is unstable."""
     n = normal_load[j]
     lim = mu[j] * n
@@ -88,14 +90,53 @@ def _key(j, f, G, mu, normal_load, hp, hv, hpos, sz):
     Ty = G[j, 1]
     T = math.sqrt(Tx * Tx + Ty * Ty)
     unstable = T > lim
-    heap_set(j, T / lim, unstable, hp, hv, hpos, 0, sz, _UNSTABLE)
-    heap_set(j, -_critical_f(G[j, 0], G[j, 1], lim, n), True, hp, hv, hpos, 1, sz, _CRITICAL)
+    heap_set(heaps, _UNSTABLE, j, T / lim, unstable)
+    heap_set(heaps, _CRITICAL, j, -_critical_f(G[j, 0], G[j, 1], lim, n), True)
     return unstable
 
 
+@kernel_jit(inline="always")
+def _displacement(net, settings, i, f, driving, G, mu):
+    """(ok, du_x, du_y): node i slips alone under its force plus the tilt f N_i along x.
+
+    A driving slip starts exactly at the threshold, as on the horizontal substrate.
+    """
+    n = net.normal_load[i]
+    Tx = G[i, 0] + f * n
+    Ty = G[i, 1]
+    fd = settings.mu_d * n
+    d = net.diag[i]
+    kxx = net.K_blocks[d, 0, 0]
+    kxy = net.K_blocks[d, 0, 1]
+    kyy = net.K_blocks[d, 1, 1]
+    if settings.slip_mode == SLIP_EXACT:
+        dux, duy, nsteps = exact_slip(Tx, Ty, kxx, kxy, kyy, fd)
+        return nsteps >= 0, dux, duy
+    norm = math.sqrt(Tx * Tx + Ty * Ty)
+    dux, duy = straight_slip(Tx, Ty, norm, mu[i] * n if driving else norm, kxx, kxy, kyy, fd)
+    return True, dux, duy
+
+
+@kernel_jit(inline="always")
+def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps):
+    """The appendix's creep rule: both thresholds redrawn, the spring force on slider 2 uniform
+    between the values that keep both sliders stable under f. Returns the new read positions."""
+    mu[0] = tilt_mu[p_mu]
+    mu[1] = tilt_mu[p_mu + 1]
+    lo = f * normal_load[0] + f_ext[0, 0] - mu[0] * normal_load[0]
+    hi = mu[1] * normal_load[1] - f * normal_load[1] - f_ext[1, 0]
+    F = lo + (hi - lo) * tilt_u[p_u]
+    G[0, 0] = f_ext[0, 0] - F
+    G[1, 0] = f_ext[1, 0] + F
+    # Both sliders are at rest: the next event is a critical f.
+    for j in range(2):
+        _key(j, f, G, mu, normal_load, heaps)
+        heap_set(heaps, _UNSTABLE, j, 0.0, False)
+    return p_mu + 2, p_u + 1
+
+
 @kernel_jit()
-def tilt_test_network(G, mu, normal_load, f_ext, f_bar, indptr, indices, kblk, diagpos, mu_d, slip_mode,
-                      pair_rule, tmu, tu, pos, max_slips, av_cap, hp, hv, hpos, epoch):
+def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch):
     """Raise a uniform tilt on a copy of a network until it slides as a whole.
 
     Parameters
@@ -105,30 +146,30 @@ def tilt_test_network(G, mu, normal_load, f_ext, f_bar, indptr, indices, kblk, d
         copy). 1D networks pass their forces in column 0 and zeros in column 1.
     mu : ndarray, shape (N,)
         Thresholds mu_s (overwritten: pass a copy).
-    normal_load : ndarray, shape (N,)
-        N_i in units of N; the tilt force on node i is f N_i along +x.
     f_ext : ndarray, shape (N, 2)
         The constant external forces included in G (used by the pair rule).
     f_bar : float
         sum_i f_ext,i,x / sum_i N_i: the external load per unit normal load along x.
-    indptr, indices, kblk, diagpos
-        Block-CSR rows of K, blocks (nnzb, 2, 2), and the slot of each K_ii.
-    mu_d : float
-        Dynamic coefficient.
-    slip_mode : int
-        0: straight-line slip; 1: exactly integrated 2D slip.
+    net : Plane
+        Block-CSR rows of K (1D padded to 2 x 2 blocks) and the loads N_i; the
+        tilt force on node i is f N_i along +x.
+    settings : Settings
+        mu_d, slip_mode (0: straight-line slip; 1: exactly integrated 2D
+        slip) and max_slips (give up after this many slips).
     pair_rule : bool
         Use the appendix's creep rule (a 1D pair of sliders).
-    tmu, tu : ndarray
+    tilt_mu, tilt_u : ndarray
         Thresholds and uniforms of the tilt stream, read from ``pos[P_MU]``
         and ``pos[P_U]``; the positions advance only if a sample is returned.
     pos : ndarray of int64, shape (N_POS,)
         Read positions (slots ``P_MU``, ``P_U``) and the slip count (``N_SLIPS``).
-    max_slips : int
-        Give up after this many slips.
     av_cap : int
         Slips of one avalanche after which a part of the network is taken to
         slide on its own (rule 4).
+    heaps : Heaps
+        Two heaps over the N nodes (work array).
+    epoch : ndarray of int64, shape (N,)
+        Work array: the avalanche in which each node last slipped.
 
     Returns
     -------
@@ -137,119 +178,81 @@ def tilt_test_network(G, mu, normal_load, f_ext, f_bar, indptr, indices, kblk, d
         if a buffer ran out, ``TILT_TOO_LONG`` after ``max_slips`` slips.
     """
     N = mu.size
+    normal_load = net.normal_load
     p_mu = pos[P_MU]
     p_u = pos[P_U]
-    sz = pos  # heap sizes live in slots _UNSTABLE and _CRITICAL
-    sz[_UNSTABLE] = 0
-    sz[_CRITICAL] = 0
-    hpos[:] = -1
+    heap_clear(heaps)
     f = 0.0
     for j in range(N):
-        _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
+        _key(j, f, G, mu, normal_load, heaps)
         epoch[j] = -1
     ep = 0
     slips = 0
     # moved: nodes that slipped in the current avalanche; pending: unstable nodes that have not.
     moved = 0
-    pending = sz[_UNSTABLE]
-    driving = True
+    pending = heaps.size[_UNSTABLE]
     av_slips = 0
     while True:
-        if sz[_UNSTABLE] == 0:
+        driving = heaps.size[_UNSTABLE] == 0
+        if driving:
             # Raise f to the next critical value; a new avalanche starts.
-            fc = -hv[1, 0]
+            fc = -heaps.key[_CRITICAL, 0]
             if fc > f:
                 f = fc
-            i = hp[1, 0]
+            i = heaps.node[_CRITICAL, 0]
             ep += 1
             moved = 0
             pending = 0
-            driving = True
             av_slips = 0
         else:
-            i = hp[0, 0]
-            driving = False
+            i = heaps.node[_UNSTABLE, 0]
         slips += 1
         av_slips += 1
-        if slips > max_slips:
-            pos[N_SLIPS] = slips
+        pos[N_SLIPS] = slips
+        if slips > settings.max_slips:
             return TILT_TOO_LONG
         if av_slips > av_cap:
-            pos[N_SLIPS] = slips
-            if f + f_bar > mu_d:
+            if f + f_bar > settings.mu_d:
                 pos[P_MU] = p_mu
                 pos[P_U] = p_u
                 return f + f_bar
             return TILT_TOO_LONG
-        n = normal_load[i]
-        lim = mu[i] * n
-        Tx = G[i, 0] + f * n
-        Ty = G[i, 1]
-        # A driving slip starts exactly at the threshold, as on the horizontal substrate.
-        T = lim if driving else math.sqrt(Tx * Tx + Ty * Ty)
         if epoch[i] != ep:
-            if hpos[i, 0] >= 0:
+            if heaps.slot[i, _UNSTABLE] >= 0:
                 pending -= 1
             epoch[i] = ep
             moved += 1
-        fd = mu_d * n
-        d = diagpos[i]
-        kxx = kblk[d, 0, 0]
-        kxy = kblk[d, 0, 1]
-        kyy = kblk[d, 1, 1]
-        if slip_mode == SLIP_EXACT:
-            dux, duy, nsteps = exact_slip(Tx, Ty, kxx, kxy, kyy, fd)
-            if nsteps < 0:
-                pos[N_SLIPS] = slips
-                return TILT_TOO_LONG
-        else:
-            dux, duy = straight_slip(Tx, Ty, math.sqrt(Tx * Tx + Ty * Ty), T, kxx, kxy, kyy, fd)
-        for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            G[j, 0] -= kblk[p, 0, 0] * dux + kblk[p, 0, 1] * duy
-            G[j, 1] -= kblk[p, 1, 0] * dux + kblk[p, 1, 1] * duy
-        for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
+        ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu)
+        if not ok:
+            return TILT_TOO_LONG
+        spread(net, G, i, dux, duy)
+        for p in range(net.indptr[i], net.indptr[i + 1]):
+            j = net.indices[p]
             if j == i:
                 continue
-            was = hpos[j, 0] >= 0
-            now = _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
+            was = heaps.slot[j, _UNSTABLE] >= 0
+            now = _key(j, f, G, mu, normal_load, heaps)
             if epoch[j] != ep:
                 pending += int(now) - int(was)
         if moved + pending == N:
             # Every node is in motion at once.
-            if f + f_bar > mu_d:
+            if f + f_bar > settings.mu_d:
                 pos[P_MU] = p_mu
                 pos[P_U] = p_u
-                pos[N_SLIPS] = slips
                 return f + f_bar
             if pair_rule:
-                if p_mu + 2 > tmu.size or p_u + 1 > tu.size:
+                if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
                     return TILT_NEED_DRAWS
-                mu[0] = tmu[p_mu]
-                mu[1] = tmu[p_mu + 1]
-                p_mu += 2
-                # The appendix: the spring force F on slider 2 uniform between
-                # the values that keep both sliders stable under f.
-                lo = f * normal_load[0] + f_ext[0, 0] - mu[0] * normal_load[0]
-                hi = mu[1] * normal_load[1] - f * normal_load[1] - f_ext[1, 0]
-                F = lo + (hi - lo) * tu[p_u]
-                p_u += 1
-                G[0, 0] = f_ext[0, 0] - F
-                G[1, 0] = f_ext[1, 0] + F
-                # Both sliders are at rest: the next event is a critical f.
-                for j in range(2):
-                    _key(j, f, G, mu, normal_load, hp, hv, hpos, sz)
-                    heap_set(j, 0.0, False, hp, hv, hpos, 0, sz, _UNSTABLE)
+                p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
                 continue
             # Damped collective motion: the avalanche goes on, counted afresh
             # from the node that is moving now.
             ep += 1
             epoch[i] = ep
             moved = 1
-            pending = sz[_UNSTABLE] - (1 if hpos[i, 0] >= 0 else 0)
-        if p_mu + 1 > tmu.size:
+            pending = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
+        if p_mu + 1 > tilt_mu.size:
             return TILT_NEED_DRAWS
-        mu[i] = tmu[p_mu]
+        mu[i] = tilt_mu[p_mu]
         p_mu += 1
-        _key(i, f, G, mu, normal_load, hp, hv, hpos, sz)
+        _key(i, f, G, mu, normal_load, heaps)

@@ -1,8 +1,8 @@
 """One backend per kernel: the state a kernel keeps for a realization, and the kernel that advances it.
 
 A :class:`~slidernet.solver.realization.Realization` holds what every scene
-has (its streams, theta(t_q), the thresholds, the counters ``ist``/``fst``,
-the draw buffers and the records) and one backend, picked once by the
+has (its streams, theta(t_q), the thresholds, the scalars ``state``, the
+draw buffers and the records) and one backend, picked once by the
 scene's kernel (:data:`BACKENDS`, the only place that reads a kernel's
 name). The realization, the tilt tests and the checkpoints talk to the
 backend through one interface and never ask which kernel it is, the way
@@ -20,6 +20,9 @@ Backends:
 - :class:`PairBackend` (``pair``): the paper's two sliders, scalars only;
 - :class:`ChainBackend` (``csr``): any 1D network, CSR rows of K;
 - :class:`PlaneBackend` (``vec``): any 2D network, 2 x 2 blocks of K.
+
+The two network backends run the same kernel, :func:`slidernet.kernels.run_network`,
+on their operators (:class:`~slidernet.kernels.Chain` or :class:`~slidernet.kernels.Plane`).
 """
 
 from __future__ import annotations
@@ -40,9 +43,9 @@ Take = Callable[..., np.ndarray]  # checkpoint._take: an array of the file, chec
 
 
 class PairBackend:
-    """The paper's two sliders (kernel ``run_pair``): the state is scalars in ``fst``, no per-node array.
+    """The paper's two sliders (kernel ``run_pair``): the state is scalars, no per-node array.
 
-    The spring's length change u (``fst[U]``) and theta give the force
+    The spring's length change u (``state["u"]``) and theta give the force
     F = theta - u at every use, so there is no force to keep, no drift, and
     nothing to save beyond the realization's own state.
     """
@@ -57,21 +60,20 @@ class PairBackend:
         return {}
 
     def run(self, real: Realization, thetas: np.ndarray) -> int:
-        sc, out = self.scene, real.out
-        return kernels.run_pair(
-            thetas, sc.rec_times, real.mu, real.ist, real.fst, real.mu_buf, real.tmu,
-            real.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, out["n"], out["mu_max"],
-            out["x_G"], out["n_records"], out["f_sum"], out["f_sq"], out["f_count"],
-        )
+        scene = self.scene
+        return kernels.run_pair(thetas, scene.out_steps, real.mu, real.state, real.buffers, real.series,
+                                scene.settings())
 
     def forces(self, real: Realization) -> np.ndarray:
-        F = real.fst[kernels.THETA] - real.fst[kernels.U]
+        st = real.state[0]
+        F = st["theta"] - st["u"]
         return np.array([-F, F])
 
     def displacements(self, real: Realization) -> np.ndarray:
         # Slider 1 and 2 about the centre of mass; u = theta(0) at rest.
-        half = 0.5 * (real.fst[kernels.U] - real.thetas[0])
-        xg = real.fst[kernels.XG]
+        st = real.state[0]
+        half = 0.5 * (st["u"] - real.thetas[0])
+        xg = st["x_G"]
         return np.array([[xg - half], [xg + half]])
 
     def recompute(self, real: Realization) -> float:
@@ -99,28 +101,23 @@ class NetworkBackend:
     """
 
     kernel: ClassVar[str]
-    _ARRAYS: ClassVar[tuple[str, ...]] = ("a", "u", "hp", "hpos", "hv", "aval_hist", "node_slips")
 
     def __init__(self, scene: Scene, real: Realization) -> None:
         self.scene = scene
         N = scene.network.n_nodes
-        g = scene.ops["g"]
+        g = scene.operators.g
         # a = F - theta g with u = 0: every spring at rest at theta(0), plus the external load.
-        self.a = -g * real.thetas[0] + self._f_ext()
-        self.u = np.zeros_like(g)
-        self.hp = np.zeros((3, N), np.int64)
-        self.hpos = np.full((N, 3), -1, np.int64)
-        self.hv = np.zeros((3, N))
-        self.aval_hist = np.zeros(kernels.N_AVALANCHE_BINS, np.int64)
-        self.node_slips = np.zeros(N, np.int64)
+        self.nodes = kernels.Nodes(a=-g * real.thetas[0] + self._f_ext(), u=np.zeros_like(g), mu=real.mu,
+                                   node_slips=np.zeros(N, np.int64),
+                                   avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64))
+        self.heaps = kernels.Heaps.empty(3, N)
         # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows,
         # Python keeps the full ones (at most max_events rows in all).
         rows = EVENT_CHUNK if scene.catalogue else 0
-        self.ev_i = np.zeros((rows, 2), np.int64)
-        self.ev_f = np.zeros((rows, 3))
+        self.catalogue = kernels.Catalogue(np.zeros((rows, 2), np.int64), np.zeros((rows, 3)))
         self.event_chunks: list[tuple[np.ndarray, np.ndarray]] = []
         self.events_complete = True
-        real.ist[kernels.EV_ON] = int(scene.catalogue)
+        real.state["ev_on"] = int(scene.catalogue)
         self.rebuild_heaps(real)
 
     def _f_ext(self) -> np.ndarray:
@@ -131,37 +128,47 @@ class NetworkBackend:
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {"mu_mean": np.zeros(T), "mu_min": np.zeros(T)}
 
+    # The compiled kernel of the network's geometry, and the one that builds its heaps.
+    _run: ClassVar[Callable[..., int]]
+    _init_heaps: ClassVar[Callable[..., None]]
+
     def rebuild_heaps(self, real: Realization) -> None:
-        raise NotImplementedError
+        type(self)._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps)
+
+    def run(self, real: Realization, thetas: np.ndarray) -> int:
+        scene = self.scene
+        return type(self)._run(thetas, scene.out_steps, scene.operators, real.state, self.nodes, self.heaps,
+                               real.buffers, self.catalogue, real.series, scene.settings())
 
     def forces(self, real: Realization) -> np.ndarray:
-        return self.a + self.scene.ops["g"] * real.fst[kernels.THETA]
+        return self.nodes.a + self.scene.operators.g * real.state["theta"][0]
 
     def displacements(self, real: Realization) -> np.ndarray:
-        return self.u.reshape(self.scene.network.n_nodes, -1)
+        return self.nodes.u.reshape(self.scene.network.n_nodes, -1)
 
     def recompute(self, real: Realization) -> float:
-        g = self.scene.ops["g"]
-        fresh = (-(self.scene.K @ self.u.reshape(-1)) - g.reshape(-1) * real.thetas[0]).reshape(g.shape)
+        g = self.scene.operators.g
+        a, u = self.nodes.a, self.nodes.u
+        fresh = (-(self.scene.K @ u.reshape(-1)) - g.reshape(-1) * real.thetas[0]).reshape(g.shape)
         fresh += self._f_ext()
-        drift = float(np.abs(fresh - self.a).max())
-        self.a[...] = fresh
-        real.ist[kernels.SINCE_RECOMPUTE] = 0
+        drift = float(np.abs(fresh - a).max())
+        a[...] = fresh
+        real.state["since_recompute"] = 0
         self.rebuild_heaps(real)
         return drift
 
     def flush_events(self, real: Realization) -> None:
         """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``."""
-        k = int(real.ist[kernels.EV_POS])
-        self.event_chunks.append((self.ev_i[:k].copy(), self.ev_f[:k].copy()))
-        real.ist[kernels.EV_POS] = 0
+        k = int(real.state["ev_pos"][0])
+        cat = self.catalogue
+        self.event_chunks.append((cat.ids[:k].copy(), cat.values[:k].copy()))
+        real.state["ev_pos"] = 0
         kept = sum(c[0].shape[0] for c in self.event_chunks)
         room = self.scene.max_events - kept
-        if room < self.ev_i.shape[0]:
-            self.ev_i = self.ev_i[:room]
-            self.ev_f = self.ev_f[:room]
+        if room < cat.ids.shape[0]:
+            self.catalogue = kernels.Catalogue(cat.ids[:room], cat.values[:room])
         if room == 0:
-            real.ist[kernels.EV_ON] = 0
+            real.state["ev_on"] = 0
             self.events_complete = False
             warnings.warn(
                 f"The event catalogue reached solver.max_events = {self.scene.max_events} events at step "
@@ -171,8 +178,8 @@ class NetworkBackend:
 
     def events(self, real: Realization) -> dict[str, np.ndarray]:
         """The catalogue so far (see :meth:`Realization.events`)."""
-        k = int(real.ist[kernels.EV_POS])
-        chunks = [*self.event_chunks, (self.ev_i[:k], self.ev_f[:k])]
+        k = int(real.state["ev_pos"][0])
+        chunks = [*self.event_chunks, (self.catalogue.ids[:k], self.catalogue.values[:k])]
         ev_i = np.concatenate([c[0] for c in chunks])
         ev_f = np.concatenate([c[1] for c in chunks])
         Ntilde = self.scene.network.Ntilde
@@ -180,7 +187,8 @@ class NetworkBackend:
                 "dx": ev_f[:, 1] * Ntilde, "dy": ev_f[:, 2] * Ntilde}
 
     def result(self, real: Realization) -> dict[str, Any]:
-        res: dict[str, Any] = {"avalanche_count": self.aval_hist.copy(), "node_slips": self.node_slips.copy(),
+        res: dict[str, Any] = {"avalanche_count": self.nodes.avalanche_count.copy(),
+                               "node_slips": self.nodes.node_slips.copy(),
                                "mu_s": real.mu.copy()}
         if self.scene.catalogue:
             res["events"] = self.events(real)
@@ -189,40 +197,45 @@ class NetworkBackend:
 
     def to_arrays(self, real: Realization) -> dict[str, np.ndarray]:
         """The backend's state as named numeric arrays (the catalogue buffer up to its last written row)."""
-        arrays = {name: getattr(self, name) for name in self._ARRAYS}
-        k = int(real.ist[kernels.EV_POS])
-        # Rows past EV_POS are stale: the kernel writes a row before anything reads it.
-        arrays["events/buffer_i"] = self.ev_i[:k]
-        arrays["events/buffer_f"] = self.ev_f[:k]
-        arrays["events/buffer_rows"] = np.array(self.ev_i.shape[0], np.int64)
+        arrays = {**self._named_arrays()}
+        k = int(real.state["ev_pos"][0])
+        # Rows past ev_pos are stale: the kernel writes a row before anything reads it.
+        arrays["events/buffer_ids"] = self.catalogue.ids[:k]
+        arrays["events/buffer_values"] = self.catalogue.values[:k]
+        arrays["events/buffer_rows"] = np.array(self.catalogue.ids.shape[0], np.int64)
         arrays["events/complete"] = np.array(self.events_complete, np.int64)
         chunks = self.event_chunks
         arrays["events/chunk_rows"] = np.array([c[0].shape[0] for c in chunks], dtype=np.int64)
-        arrays["events/chunks_i"] = np.concatenate([np.zeros((0, 2), np.int64)] + [c[0] for c in chunks])
-        arrays["events/chunks_f"] = np.concatenate([np.zeros((0, 3))] + [c[1] for c in chunks])
+        arrays["events/chunks_ids"] = np.concatenate([np.zeros((0, 2), np.int64)] + [c[0] for c in chunks])
+        arrays["events/chunks_values"] = np.concatenate([np.zeros((0, 3))] + [c[1] for c in chunks])
         return arrays
+
+    def _named_arrays(self) -> dict[str, np.ndarray]:
+        """The per-node state and the heaps, by name (``nodes/a``, ``heaps/key``, ...); ``mu`` is the
+        realization's own."""
+        named = {f"nodes/{name}": a for name, a in self.nodes._asdict().items() if name != "mu"}
+        named.update({f"heaps/{name}": a for name, a in self.heaps._asdict().items()})
+        return named
 
     def from_arrays(self, real: Realization, arrays: dict[str, np.ndarray], take: Take) -> None:
         """Overwrite the state from :meth:`to_arrays`' arrays (``take`` checks each one).
 
         Call it after the realization's counters are restored: the catalogue's
-        write position is ``real.ist[EV_POS]``.
+        write position is ``real.state["ev_pos"]``.
         """
         # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
-        for name in self._ARRAYS:
-            target = getattr(self, name)
+        for name, target in self._named_arrays().items():
             target[...] = take(arrays, name, target)
-        k = int(real.ist[kernels.EV_POS])
+        k = int(real.state["ev_pos"][0])
         rows = int(take(arrays, "events/buffer_rows", dtype=np.int64, ndim=0))
         if not 0 <= k <= rows:
             raise ValueError(f"{k} catalogue rows are written in a buffer of {rows}")
-        self.ev_i = np.zeros((rows, 2), np.int64)
-        self.ev_f = np.zeros((rows, 3))
-        self.ev_i[:k] = take(arrays, "events/buffer_i", self.ev_i[:k])
-        self.ev_f[:k] = take(arrays, "events/buffer_f", self.ev_f[:k])
+        self.catalogue = kernels.Catalogue(np.zeros((rows, 2), np.int64), np.zeros((rows, 3)))
+        self.catalogue.ids[:k] = take(arrays, "events/buffer_ids", self.catalogue.ids[:k])
+        self.catalogue.values[:k] = take(arrays, "events/buffer_values", self.catalogue.values[:k])
         counts = take(arrays, "events/chunk_rows", dtype=np.int64, ndim=1)
-        ev_i = take(arrays, "events/chunks_i", dtype=np.int64, ndim=2)
-        ev_f = take(arrays, "events/chunks_f", dtype=np.float64, ndim=2)
+        ev_i = take(arrays, "events/chunks_ids", dtype=np.int64, ndim=2)
+        ev_f = take(arrays, "events/chunks_values", dtype=np.float64, ndim=2)
         total = int(counts.sum())
         if (counts < 0).any() or ev_i.shape != (total, 2) or ev_f.shape != (total, 3):
             raise ValueError(f"the catalogue chunks of {counts.tolist()} rows are {ev_i.shape} and {ev_f.shape}")
@@ -233,49 +246,23 @@ class NetworkBackend:
 
 
 class ChainBackend(NetworkBackend):
-    """Any 1D network (kernel ``run_csr``): CSR rows of K, scalar forces."""
+    """Any 1D network (``solver.kernel = "csr"``): CSR rows of K, scalar forces."""
 
     kernel: ClassVar[str] = "csr"
-
-    def rebuild_heaps(self, real: Realization) -> None:
-        o = self.scene.ops
-        kernels.init_csr_heaps(self.a, o["g"], real.mu, o["normal_load"], self.hp, self.hv,
-                               self.hpos, real.ist, real.fst)
-
-    def run(self, real: Realization, thetas: np.ndarray) -> int:
-        sc, o, out = self.scene, self.scene.ops, real.out
-        return kernels.run_csr(
-            thetas, sc.rec_times, real.mu, real.ist, real.fst, self.a, self.u, real.mu_buf,
-            real.tmu, real.tu, sc.mu_d, sc.do_tilt, sc.max_avalanche, sc.recompute_every,
-            o["indptr"], o["indices"], o["kdata"], o["kdiag"], o["g"], o["normal_load"],
-            o["w"], self.hp, self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i,
-            self.ev_f, out["n"], out["mu_max"], out["x_G"], out["n_records"], out["mu_mean"],
-            out["mu_min"], out["f_sum"], out["f_sq"], out["f_count"],
-        )
+    _run = kernels.run_chain
+    _init_heaps = kernels.init_chain_heaps
 
 
 class PlaneBackend(NetworkBackend):
-    """Any 2D network (kernel ``run_vec``): 2 x 2 blocks of K, vector forces, the centre of mass along y too."""
+    """Any 2D network (``solver.kernel = "vec"``): 2 x 2 blocks of K, vector forces, the centre of mass
+    along y too."""
 
     kernel: ClassVar[str] = "vec"
+    _run = kernels.run_plane
+    _init_heaps = kernels.init_plane_heaps
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {**super().records(T), "y_G": np.zeros(T)}
-
-    def rebuild_heaps(self, real: Realization) -> None:
-        o = self.scene.ops
-        kernels.init_vec_heaps(self.a, o["g"], real.mu, o["normal_load"], self.hp,
-                               self.hv, self.hpos, real.ist, real.fst)
-
-    def run(self, real: Realization, thetas: np.ndarray) -> int:
-        sc, o, out = self.scene, self.scene.ops, real.out
-        return kernels.run_vec(
-            thetas, sc.rec_times, real.mu, real.ist, real.fst, self.a, self.u, real.mu_buf,
-            sc.mu_d, sc.max_avalanche, sc.recompute_every, sc.slip_mode, o["indptr"],
-            o["indices"], o["kblk"], o["diagpos"], o["g"], o["normal_load"], o["unit_load"], o["w"], self.hp,
-            self.hv, self.hpos, self.aval_hist, self.node_slips, self.ev_i, self.ev_f, out["n"], out["mu_max"],
-            out["x_G"], out["y_G"], out["n_records"], out["mu_mean"], out["mu_min"],
-        )
 
 
 # The one place where a kernel's name is read: the scene's choice picks the backend.

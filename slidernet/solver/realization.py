@@ -22,6 +22,9 @@ from slidernet.solver.backends import backend_for
 from slidernet.solver.scene import Scene, tilt_avalanche_cap
 from slidernet.solver.streams import _refill, horizontal_draws, realization_streams
 
+# Series fields a scene does not record, as the kernels take them (0-length arrays, never written).
+_NOTHING = {"mu_mean": np.empty(0), "mu_min": np.empty(0), "y_G": np.empty(0)}
+
 
 class Realization:
     """One realization: its random streams, its state and its records.
@@ -70,14 +73,13 @@ class Realization:
         self.draws = {name: TruncatedStream(scene.distribution, self.rngs[name])
                       for name in ("thresholds", "tilt")}
         self.thetas, self.mu, self._mu_batches = horizontal_draws(scene, self.rngs, self.draws["thresholds"])
-        self.mu_buf = next(self._mu_batches)
+        # The draws waiting for the kernel; a refill replaces an array (Draws._replace).
         if scene.tilt_at is not None:
-            self.tmu = self.draws["tilt"].take(scene.batch)
-            self.tu = self.rngs["tilt_uniforms"].random(scene.batch)
+            tilt = (self.draws["tilt"].take(scene.batch), self.rngs["tilt_uniforms"].random(scene.batch))
         else:
-            self.tmu = np.empty(0)
-            self.tu = np.empty(0)
-        T = scene.rec_times.size
+            tilt = (np.empty(0), np.empty(0))
+        self.buffers = kernels.Draws(next(self._mu_batches), *tilt)
+        T = scene.out_steps.size
         self.out = {
             "n": np.zeros(T, np.int64),
             "mu_max": np.zeros(T),
@@ -88,15 +90,18 @@ class Realization:
             "f_count": np.zeros(T, np.int64),
         }
         self._tilted = 0  # recorded times whose network tilt test is done
-        self._tilt_work: tuple[np.ndarray, ...] | None = None
-        self.ist, self.fst = kernels.empty_state()
-        self.fst[kernels.THETA] = self.thetas[0]
-        self.fst[kernels.U] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
-        self.fst[kernels.MU_MAX] = self.mu.max()
-        self.ist[kernels.ARGMAX] = int(np.argmax(self.mu))
+        self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray] | None = None
+        self.state = kernels.new_state()
+        self.state["theta"] = self.thetas[0]
+        self.state["u"] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
+        self.state["mu_max"] = self.mu.max()
+        self.state["argmax"] = int(np.argmax(self.mu))
         # The kernel's own state; the backend is the only part that knows which kernel runs.
         self.backend = backend_for(scene, self)
         self.out.update(self.backend.records(T))
+        # The kernels' view of the records: the same arrays, 0-length where the scene records nothing.
+        self.series = kernels.Series(**{name: self.out[name] if name in self.out else _NOTHING[name]
+                                        for name in kernels.Series._fields})
 
     def recompute_forces(self) -> float:
         """Recompute a = -K u - g theta(0) + f_ext from the displacements (sparse mat-vec).
@@ -116,12 +121,12 @@ class Realization:
     @property
     def step(self) -> int:
         """The number of thermal steps done so far."""
-        return int(self.ist[kernels.Q])
+        return int(self.state["q"][0])
 
     @property
     def n(self) -> int:
         """Cumulative number of rearrangements."""
-        return int(self.ist[kernels.N_SLIPS])
+        return int(self.state["n_slips"][0])
 
     @property
     def thresholds(self) -> np.ndarray:
@@ -131,12 +136,12 @@ class Realization:
     @property
     def theta(self) -> float:
         """Current dilation theta (dimensionless)."""
-        return float(self.fst[kernels.THETA] * self.scene.network.Ntilde)
+        return float(self.state["theta"][0] * self.scene.network.Ntilde)
 
     @property
     def x_G(self) -> float:
         """Current centre-of-mass displacement, in l0."""
-        return float(self.fst[kernels.XG] * self.scene.network.Ntilde)
+        return float(self.state["x_G"][0] * self.scene.network.Ntilde)
 
     def forces(self) -> np.ndarray:
         """Spring forces on every node, in units of N, shape (N,) in 1D or (N, 2) in 2D."""
@@ -152,13 +157,13 @@ class Realization:
         With ``mu_eff_at = "records"`` the network tilt test is made on the
         state at every recorded time passed on the way.
         """
-        sc = self.scene
-        to_step = sc.steps if to_step is None else int(to_step)
-        if not self.step <= to_step <= sc.steps:
-            raise ValueError(f"to_step must lie in [{self.step}, {sc.steps}]; got {to_step}")
-        if sc.tilt_at == "records":
-            while self._tilted < sc.rec_times.size and sc.rec_times[self._tilted] <= to_step:
-                self._run_kernel(int(sc.rec_times[self._tilted]))
+        scene = self.scene
+        to_step = scene.steps if to_step is None else int(to_step)
+        if not self.step <= to_step <= scene.steps:
+            raise ValueError(f"to_step must lie in [{self.step}, {scene.steps}]; got {to_step}")
+        if scene.tilt_at == "records":
+            while self._tilted < scene.out_steps.size and scene.out_steps[self._tilted] <= to_step:
+                self._run_kernel(int(scene.out_steps[self._tilted]))
                 self._tilt_record(self._tilted)
                 self._tilted += 1
         return self._run_kernel(to_step)
@@ -175,29 +180,28 @@ class Realization:
         """
         from slidernet.kernels.tilt_net import N_POS, N_SLIPS, P_MU, P_U, TILT_NEED_DRAWS, tilt_test_network
 
-        sc = self.scene
-        o = sc.tilt_ops()
-        N = sc.network.n_nodes
+        scene = self.scene
+        o = scene.tilt_operators()
+        N = scene.network.n_nodes
         if self._tilt_work is None:
-            self._tilt_work = (np.zeros((2, N), np.int64), np.zeros((2, N)), np.zeros((N, 2), np.int64),
-                               np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
-        hp, hv, hpos, epoch, pos = self._tilt_work
+            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
+        heaps, epoch, pos = self._tilt_work
         F = self.forces().reshape(N, -1)
+        st = self.state
         while True:
             G = np.zeros((N, 2))
             G[:, : F.shape[1]] = F
-            pos[P_MU], pos[P_U] = self.ist[kernels.TMU_POS], self.ist[kernels.TU_POS]
-            f = tilt_test_network(G, self.mu.copy(), sc.network.normal_load, o["f_ext"], o["f_bar"], o["indptr"],
-                                  o["indices"], o["kblk"], o["diagpos"], sc.mu_d, sc.slip_mode,
-                                  o["pair_rule"], self.tmu, self.tu, pos, sc.max_avalanche,
-                                  tilt_avalanche_cap(N), hp, hv, hpos, epoch)
+            pos[P_MU], pos[P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
+            f = tilt_test_network(G, self.mu.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
+                                  self.buffers.tilt_mu, self.buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps,
+                                  epoch)
             if f >= 0.0:
-                self.ist[kernels.TMU_POS], self.ist[kernels.TU_POS] = pos[P_MU], pos[P_U]
+                st["tilt_mu_pos"], st["tilt_u_pos"] = pos[P_MU], pos[P_U]
                 return float(f)
             if f != TILT_NEED_DRAWS:
                 raise TiltTestError(
                     f"The network tilt test did not reach sliding at step {self.step}: it made "
-                    f"{int(pos[N_SLIPS])} slips (at most solver.max_avalanche = {sc.max_avalanche} in all, "
+                    f"{int(pos[N_SLIPS])} slips (at most solver.max_avalanche = {scene.max_avalanche} in all, "
                     f"{tilt_avalanche_cap(N)} in one avalanche) with the load per unit normal load still "
                     f"at or below mu_d."
                 )
@@ -215,14 +219,16 @@ class Realization:
         unread draws gets a batch. If both still held a batch, one test needed
         more than that (a long avalanche): both grow, so that the retry gets further.
         """
-        sc, ist = self.scene, self.ist
-        unread = min(self.tmu.size - ist[kernels.TMU_POS], self.tu.size - ist[kernels.TU_POS])
+        scene, st, buf = self.scene, self.state[0], self.buffers
+        unread = min(buf.tilt_mu.size - st["tilt_mu_pos"], buf.tilt_u.size - st["tilt_u_pos"])
         # Doubling when both held a batch keeps the retries logarithmic in the test's length.
-        batch = sc.batch if unread < sc.batch else 2 * max(self.tmu.size, self.tu.size)
-        self.tmu = _refill(self.tmu, ist[kernels.TMU_POS], self.draws["tilt"].take, batch)
-        self.tu = _refill(self.tu, ist[kernels.TU_POS], self.rngs["tilt_uniforms"].random, batch)
-        ist[kernels.TMU_POS] = 0
-        ist[kernels.TU_POS] = 0
+        batch = scene.batch if unread < scene.batch else 2 * max(buf.tilt_mu.size, buf.tilt_u.size)
+        self.buffers = buf._replace(
+            tilt_mu=_refill(buf.tilt_mu, st["tilt_mu_pos"], self.draws["tilt"].take, batch),
+            tilt_u=_refill(buf.tilt_u, st["tilt_u_pos"], self.rngs["tilt_uniforms"].random, batch),
+        )
+        self.state["tilt_mu_pos"] = 0
+        self.state["tilt_u_pos"] = 0
 
     def _tilt_record(self, k: int) -> None:
         f = self.tilt_test()
@@ -231,21 +237,22 @@ class Realization:
         self.out["f_count"][k] += 1
 
     def _run_kernel(self, to_step: int) -> Realization:
-        sc = self.scene
+        scene = self.scene
         # The kernel stops at the end of the array it is given.
         thetas = self.thetas[: to_step + 1]
-        ist = self.ist
+        st = self.state
 
         def draw_mu(size: int) -> np.ndarray:
-            return next(self._mu_batches)  # size is always sc.batch
+            return next(self._mu_batches)  # size is always scene.batch
 
         while True:
             status = self.backend.run(self, thetas)
             if status == kernels.DONE:
                 return self
             if status == kernels.NEED_MU:
-                self.mu_buf = _refill(self.mu_buf, ist[kernels.MU_POS], draw_mu, sc.batch)
-                ist[kernels.MU_POS] = 0
+                fresh = _refill(self.buffers.mu, st["mu_pos"][0], draw_mu, scene.batch)
+                self.buffers = self.buffers._replace(mu=fresh)
+                st["mu_pos"] = 0
             elif status == kernels.NEED_TILT:
                 self._refill_tilt()
             elif status == kernels.RECOMPUTE:
@@ -253,12 +260,12 @@ class Realization:
             elif status == kernels.NEED_EVENTS:
                 self.backend.flush_events(self)
             elif status == kernels.AVALANCHE_LIMIT:
-                i = int(ist[kernels.ERR_NODE])
+                i = int(st["err_node"][0])
                 force = np.round(np.atleast_1d(self.forces()[i]), 12).tolist()
                 raise AvalancheError(
-                    f"An avalanche did not end after {sc.max_avalanche} slips "
+                    f"An avalanche did not end after {scene.max_avalanche} slips "
                     f"(solver.max_avalanche), or a slip did not come to rest, during step "
-                    f"{ist[kernels.Q]}: node {i} is unstable with F = {force} N, "
+                    f"{self.step}: node {i} is unstable with F = {force} N, "
                     f"mu_s = {float(self.mu[i])!r}, theta = {self.theta!r}. "
                     + ("A load f_ext that friction cannot hold makes the network (or a floppy part of it, "
                        "such as a row of a square lattice) slide for ever: lower f_ext. "
@@ -268,7 +275,7 @@ class Realization:
             elif status == kernels.TILT_LIMIT:
                 raise TiltTestError(
                     f"The tilt test did not reach sliding within {kernels.TILT_MAX_ITER} "
-                    f"iterations at step {ist[kernels.Q]}."
+                    f"iterations at step {self.step}."
                 )
             else:  # pragma: no cover - a new status code without a handler is a bug
                 raise RuntimeError(f"unknown kernel status {status}")
@@ -288,7 +295,7 @@ class Realization:
         return self.backend.events(self)
 
     def result(self) -> dict[str, np.ndarray]:
-        """The records at ``scene.rec_times`` (x_G converted to l0).
+        """The records at ``scene.out_steps`` (x_G converted to l0).
 
         Returns
         -------
@@ -302,7 +309,7 @@ class Realization:
         res["x_G"] *= Ntilde
         if "y_G" in res:
             res["y_G"] *= Ntilde
-        res["n_events"] = np.int64(self.ist[kernels.N_EVENTS])
+        res["n_events"] = np.int64(self.state["n_events"][0])
         res.update(self.backend.result(self))
         return res
 

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from slidernet.config import Config, build_network, choose_kernel
 from slidernet.errors import ConfigError
+from slidernet.kernels import Chain, Plane, Settings
 from slidernet.model.network import Network
 
 
@@ -34,47 +35,58 @@ def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> n
 EVENT_CHUNK = 1 << 16  # rows of the event-catalogue buffer the kernel fills between returns
 
 
-def _operators(net: Network) -> tuple[str, Any, dict[str, np.ndarray]]:
-    """The kernel family of a network, its stiffness matrix K and the arrays the kernel runs on.
+def _operators(net: Network) -> tuple[str, Any, Chain | Plane]:
+    """The kernel family of a network, its stiffness matrix K and the operators the kernel runs on.
 
-    1D: the CSR rows of K. 2D: the block-CSR rows of its 2x2 blocks, which
-    share memory with the returned ``scipy.sparse.bsr_matrix``. Entries of g
-    below 1e-12 of its largest entry are set to exactly zero: in a uniform
-    lattice the interior loads cancel up to rounding, and a node with g_i = 0
-    is never driven directly (it stays out of the driving heaps).
+    1D: the CSR rows of K (:class:`~slidernet.kernels.state.Chain`). 2D:
+    the block-CSR rows of its 2x2 blocks (:class:`~slidernet.kernels.state.Plane`),
+    which share memory with the returned ``scipy.sparse.bsr_matrix``.
+    Entries of g below 1e-12 of its largest entry are set to exactly zero:
+    in a uniform lattice the interior loads cancel up to rounding, and a
+    node with g_i = 0 is never driven directly (it stays out of the driving
+    heaps).
     """
     g = net.thermal_load()
     gmax = np.abs(g).max() if g.size else 0.0
     g = np.where(np.abs(g) > 1e-12 * gmax, g, 0.0)
-    common = {
-        "normal_load": net.normal_load.astype(np.float64),
-        "w": net.normal_load / net.normal_load.sum(),
-    }
+    normal_load = net.normal_load.astype(np.float64)
+    w = net.normal_load / net.normal_load.sum()
+    unit_load = bool((net.normal_load == 1.0).all())
     if net.dim == 1:
         K = net.stiffness_matrix()
-        return "csr", K, {
-            **common,
-            "indptr": K.indptr.astype(np.int64),
-            "indices": K.indices.astype(np.int64),
-            "kdata": K.data.astype(np.float64),
-            "kdiag": K.diagonal().astype(np.float64),
-            "g": g.astype(np.float64),
-        }
+        return "csr", K, Chain(
+            indptr=K.indptr.astype(np.int64),
+            indices=K.indices.astype(np.int64),
+            K_data=K.data.astype(np.float64),
+            K_diag=K.diagonal().astype(np.float64),
+            g=g.astype(np.float64),
+            normal_load=normal_load,
+            w=w,
+            unit_load=unit_load,
+        )
     K = net.stiffness_blocks()
-    indptr = K.indptr.astype(np.int64)
-    indices = K.indices.astype(np.int64)
-    row = np.repeat(np.arange(net.n_nodes), np.diff(indptr))
-    g2 = g.reshape(-1, 2).astype(np.float64)
-    return "vec", K, {
-        **common,
-        "indptr": indptr,
-        "indices": indices,
-        "kblk": K.data,
-        "diagpos": np.flatnonzero(indices == row).astype(np.int64),
-        "g": g2,
-        "driven": (g2 != 0).any(axis=1),  # informative: the kernel reads g itself
-        "unit_load": bool((net.normal_load == 1.0).all()),
-    }
+    return "vec", K, _plane(K.indptr, K.indices, K.data, g.reshape(-1, 2).astype(np.float64), normal_load, w,
+                            unit_load)
+
+
+def _plane(indptr: np.ndarray, indices: np.ndarray, blocks: np.ndarray, g: np.ndarray, normal_load: np.ndarray,
+           w: np.ndarray, unit_load: bool) -> Plane:
+    """The 2D operators from the block-CSR rows of K: ``blocks`` (nnzb, 2, 2) of the rows ``indptr``."""
+    indptr = indptr.astype(np.int64)
+    indices = indices.astype(np.int64)
+    row = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    return Plane(indptr=indptr, indices=indices, K_blocks=blocks,
+                 diag=np.flatnonzero(indices == row).astype(np.int64), g=g, normal_load=normal_load, w=w,
+                 unit_load=unit_load)
+
+
+class TiltOperators(NamedTuple):
+    """What the network tilt test runs on (:func:`slidernet.kernels.tilt_net.tilt_test_network`)."""
+
+    net: Plane  # block-CSR rows of K with 2 x 2 blocks, 1D padded with zeros
+    f_ext: np.ndarray  # (N, 2) external forces, in N
+    f_bar: float  # sum_i f_ext,i,x / sum_i N_i
+    pair_rule: bool  # the appendix's creep rule applies (a 1D pair)
 
 
 @dataclass
@@ -86,8 +98,8 @@ class Scene:
     kernel : {"pair", "csr", "vec"}
         The specialized kernel picked for this scene: ``pair`` for the
         paper's two sliders, ``csr`` for other 1D networks, ``vec`` in 2D.
-    ops : dict of str to ndarray
-        The arrays the network kernels run on (see ``_operators``).
+    operators : Chain or Plane
+        The network's operators the kernels run on (see ``_operators``).
     K : scipy.sparse matrix or None
         The stiffness matrix, for the periodic recomputation of the forces.
     """
@@ -99,7 +111,7 @@ class Scene:
     distribution_name: str
     mu_d: float
     steps: int
-    rec_times: np.ndarray
+    out_steps: np.ndarray
     kernel: str
     tilt_at: str | None
     max_avalanche: int
@@ -108,26 +120,32 @@ class Scene:
     slip_mode: int
     catalogue: bool = False
     max_events: int = 0
-    ops: dict[str, np.ndarray] = field(default_factory=dict)
+    operators: Chain | Plane | None = None
     K: Any = None
-    _tilt_ops: dict[str, Any] | None = field(default=None, repr=False)
+    _tilt_operators: TiltOperators | None = field(default=None, repr=False)
 
     @property
     def do_tilt(self) -> bool:
         """True if the kernel makes the appendix's tilt test before every rearrangement."""
         return self.tilt_at == "rearrangements"
 
-    def tilt_ops(self) -> dict[str, Any]:
-        """The arrays of the network tilt test (built on first use; 1D padded to 2D)."""
-        if self._tilt_ops is None:
-            self._tilt_ops = _tilt_operators(self.network)
-        return self._tilt_ops
+    def tilt_operators(self) -> TiltOperators:
+        """The operators of the network tilt test (built on first use; 1D padded to 2D)."""
+        if self._tilt_operators is None:
+            self._tilt_operators = _tilt_operators(self.network)
+        return self._tilt_operators
+
+    def settings(self) -> Settings:
+        """The run's constants, as the kernels take them."""
+        return Settings(mu_d=float(self.mu_d), max_slips=int(self.max_avalanche),
+                        recompute_every=int(self.recompute_every), do_tilt=bool(self.do_tilt),
+                        slip_mode=int(self.slip_mode))
 
     @classmethod
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
-        family, K, ops = _operators(net)
+        family, K, operators = _operators(net)
         catalogue = "events" in cfg.observables
         kernel = choose_kernel(cfg.solver.kernel, net.is_two_slider(), net.dim, catalogue)
         if kernel != family and not (kernel == "pair" and net.is_two_slider()):
@@ -151,7 +169,7 @@ class Scene:
             distribution_name=cfg.friction.static.name,
             mu_d=cfg.friction.mu_d,
             steps=cfg.steps,
-            rec_times=record_times(cfg.steps, cfg.record, cfg.log_points_per_decade),
+            out_steps=record_times(cfg.steps, cfg.record, cfg.log_points_per_decade),
             kernel=kernel,
             tilt_at=tilt_at,
             max_avalanche=cfg.solver.max_avalanche,
@@ -160,7 +178,7 @@ class Scene:
             slip_mode=1 if cfg.solver.slip == "exact" else 0,
             catalogue=catalogue,
             max_events=cfg.solver.max_events,
-            ops=ops,
+            operators=operators,
             K=K,
         )
 
@@ -175,26 +193,19 @@ def pair_tilt_applies(net: Network) -> bool:
             and not net.f_ext.any())
 
 
-def _tilt_operators(net: Network) -> dict[str, Any]:
+def _tilt_operators(net: Network) -> TiltOperators:
     """Block-CSR rows of K with 2 x 2 blocks (1D padded with zeros) for the network tilt test."""
     K = net.stiffness_blocks()
-    indptr = K.indptr.astype(np.int64)
-    indices = K.indices.astype(np.int64)
-    blocks = np.zeros((indices.size, 2, 2))
     d = net.dim
+    blocks = np.zeros((K.data.shape[0], 2, 2))
     blocks[:, :d, :d] = K.data
-    row = np.repeat(np.arange(net.n_nodes), np.diff(indptr))
     f_ext = np.zeros((net.n_nodes, 2))
     f_ext[:, :d] = net.f_ext
-    return {
-        "indptr": indptr,
-        "indices": indices,
-        "kblk": blocks,
-        "diagpos": np.flatnonzero(indices == row).astype(np.int64),
-        "f_ext": f_ext,
-        "f_bar": float(f_ext[:, 0].sum() / net.normal_load.sum()),
-        "pair_rule": net.n_nodes == 2 and d == 1,
-    }
+    normal_load = net.normal_load.astype(np.float64)
+    plane = _plane(K.indptr, K.indices, blocks, np.zeros((net.n_nodes, 2)), normal_load,
+                   normal_load / normal_load.sum(), bool((normal_load == 1.0).all()))
+    return TiltOperators(net=plane, f_ext=f_ext, f_bar=float(f_ext[:, 0].sum() / net.normal_load.sum()),
+                         pair_rule=net.n_nodes == 2 and d == 1)
 
 
 def tilt_avalanche_cap(n_nodes: int) -> int:

@@ -181,7 +181,7 @@ class Dynamics:
         # Dense operators: the networks integrated here are small (N <= ~16),
         # and a dense sub-block product is the cheapest right-hand side.
         self.K = net.stiffness_matrix().toarray()
-        self.g = np.asarray(scene.ops["g"], dtype=np.float64)
+        self.g = np.asarray(scene.operators.g, dtype=np.float64)
         self.normal_load = net.normal_load.astype(np.float64)
         self.w = self.normal_load / self.normal_load.sum()
         self.f_ext = net.f_ext[:, 0].astype(np.float64)
@@ -211,11 +211,11 @@ class Dynamics:
             computed in the integrator's local time, so exact even where
             ``start`` is large), ``node`` (int64), ``du`` (l0).
         """
-        sc = self.scene
-        steps = sc.steps if steps is None else steps
-        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= sc.steps:
-            raise param_error("steps", "Dynamics.run", f"an integer in [0, {sc.steps}]", steps)
-        thetas, draws = realization_draws(sc, seed_seq)
+        scene = self.scene
+        steps = scene.steps if steps is None else steps
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= scene.steps:
+            raise param_error("steps", "Dynamics.run", f"an integer in [0, {scene.steps}]", steps)
+        thetas, draws = realization_draws(scene, seed_seq)
         return _Realization(self, thetas, draws).run(int(steps))
 
 
@@ -259,7 +259,7 @@ class _Realization:
 
     def run(self, steps: int) -> dict[str, np.ndarray]:
         d, thetas = self.d, self.thetas
-        rec = d.scene.rec_times[d.scene.rec_times <= steps]
+        rec = d.scene.out_steps[d.scene.out_steps <= steps]
         out_n = np.zeros(rec.size, np.int64)
         out_mu_max = np.zeros(rec.size)
         out_xg = np.zeros(rec.size)

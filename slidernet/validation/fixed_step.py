@@ -25,7 +25,7 @@ AVALANCHE_LIMIT = -2
 
 
 @kernel_jit()
-def sweep_pair(thetas, dtheta, rec_times, mu, draws, mu_d, max_slips, out_n, out_mu_max, out_xg):
+def sweep_pair(thetas, dtheta, out_steps, mu, draws, mu_d, max_slips, out_n, out_mu_max, out_xg):
     """Run one realization of the two sliders with a fixed-step theta sweep.
 
     Parameters
@@ -35,7 +35,7 @@ def sweep_pair(thetas, dtheta, rec_times, mu, draws, mu_d, max_slips, out_n, out
     dtheta : float
         Largest sub-step of theta / Ntilde; each thermal step is cut into
         ceil(|Delta theta| / dtheta) equal sub-steps ending exactly at theta(t_q+1).
-    rec_times : ndarray of int64, shape (T,)
+    out_steps : ndarray of int64, shape (T,)
         Recorded steps, increasing.
     mu : ndarray, shape (2,)
         Initial thresholds (mu_s,1, mu_s,2); overwritten with the final ones.
@@ -60,7 +60,7 @@ def sweep_pair(thetas, dtheta, rec_times, mu, draws, mu_d, max_slips, out_n, out
     k = 0
     mu0 = mu[0]
     mu1 = mu[1]
-    if rec_times.size > 0 and rec_times[0] == 0:
+    if out_steps.size > 0 and out_steps[0] == 0:
         out_n[0] = 0
         out_mu_max[0] = max(mu0, mu1)
         out_xg[0] = 0.0
@@ -99,7 +99,7 @@ def sweep_pair(thetas, dtheta, rec_times, mu, draws, mu_d, max_slips, out_n, out
                 slips += 1
                 if slips > max_slips:
                     return AVALANCHE_LIMIT
-        if k < rec_times.size and rec_times[k] == q + 1:
+        if k < out_steps.size and out_steps[k] == q + 1:
             out_n[k] = n
             out_mu_max[k] = max(mu0, mu1)
             out_xg[k] = xg

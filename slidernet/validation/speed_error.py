@@ -154,7 +154,7 @@ def fixed_step_final(scene: Scene, seeds: list[np.random.SeedSequence], dtheta: 
     from slidernet.validation.fixed_step import AVALANCHE_LIMIT, OUT_OF_DRAWS, sweep_pair
 
     out: dict[str, list[float]] = {"n": [], "mu_max": [], "x_G": []}
-    rec = scene.rec_times
+    rec = scene.out_steps
     for ss in seeds:
         thetas, mu0, batches = horizontal_draws(scene, realization_streams(ss))
         draws = next(batches)

@@ -1,4 +1,4 @@
-"""General 2D networks: vector forces, 2x2 blocks of K, three heaps.
+"""The geometry of 2D networks: vector forces, 2x2 blocks of K.
 
 The force on node i is the 2-vector F_i = a_i + g_i theta (a = -K u - g
 theta(0) + f_ext), and node i sticks while |F_i| <= mu_s,i N_i. Along a
@@ -16,46 +16,19 @@ under Coulomb friction with the local stiffness K_ii (a 2x2 block):
 * ``slip_mode = 1`` (exact): the 2D motion u'' = F_i - K_ii (u - u0) - mu_d N_i v/|v|
   is integrated (adaptive RK4, see :func:`exact_slip`) from rest until the
   node sticks. benchmarks/slip_error.py measures what the straight line costs.
+
+These are the pieces of :func:`slidernet.kernels.network.run_network` that
+depend on the dimension; the driving loop itself is shared with 1D networks
+(:mod:`slidernet.kernels.chain`).
 """
 
 from __future__ import annotations
 
 import math
 
-from slidernet.kernels.heap import (
-    avalanche_done,
-    buffers_low,
-    close_t0,
-    end_step,
-    heap_set,
-    log_event,
-    mu_stats,
-    next_driving_event,
-    open_driving_event,
-    open_initial_relaxation,
-    redraw_threshold,
-)
-from slidernet.kernels.state import (
-    AV_SLIPS,
-    AVALANCHE_LIMIT,
-    DONE,
-    DOWN_SIZE,
-    ERR_NODE,
-    HEAP_SIZE,
-    IN_AVALANCHE,
-    MU_MAX,
-    N_RECORDS,
-    N_SLIPS,
-    REC,
-    RECOMPUTE,
-    SINCE_RECOMPUTE,
-    THETA,
-    UP_SIZE,
-    XG,
-    YG,
-    Q,
-    kernel_jit,
-)
+from slidernet.kernels.heap import heap_set, set_critical
+from slidernet.kernels.network import init_heaps, run_network
+from slidernet.kernels.state import UNSTABLE, kernel_jit
 
 SLIP_STRAIGHT = 0
 SLIP_EXACT = 1
@@ -209,39 +182,25 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd):
 
 
 @kernel_jit(inline="always")
-def update_node(j, theta, a, g, mu, normal_load, unit_load, hp, hv, hpos, ist):
+def update_node(net, nodes, heaps, j, theta):
     """Re-key node j in the three heaps after its force or threshold changed."""
-    gx = g[j, 0]
-    gy = g[j, 1]
+    a = nodes.a
+    gx = net.g[j, 0]
+    gy = net.g[j, 1]
     Fx = a[j, 0] + gx * theta
     Fy = a[j, 1] + gy * theta
     F2 = Fx * Fx + Fy * Fy  # forces are O(1) in these units: no overflow, hypot not needed
     # With unit loads (every lattice by default) the load array stays out of the cache.
-    lim = mu[j] if unit_load else mu[j] * normal_load[j]
-    # Most updated nodes are stable and out of the heap: skip the call then.
-    if F2 > lim * lim or hpos[j, 0] >= 0:
+    lim = nodes.mu[j] if net.unit_load else nodes.mu[j] * net.normal_load[j]
+    # Most updated nodes are stable and out of the heap: skip the call (and the root) then.
+    if F2 > lim * lim or heaps.slot[j, UNSTABLE] >= 0:
         F = math.sqrt(F2)
-        heap_set(j, F / lim, F > lim, hp, hv, hpos, 0, ist, HEAP_SIZE)
+        heap_set(heaps, UNSTABLE, j, F / lim, F > lim)
     # Driven nodes (g_j != 0) are those of the `driven` mask; reading g, already
     # at hand, spares a cache line per neighbour.
     if gx != 0.0 or gy != 0.0:
         dn, up = critical_thetas(a[j, 0], a[j, 1], gx, gy, lim)
-        heap_set(j, -up, True, hp, hv, hpos, 1, ist, UP_SIZE)
-        heap_set(j, dn, True, hp, hv, hpos, 2, ist, DOWN_SIZE)
-
-
-@kernel_jit()
-def init_vec_heaps(a, g, mu, normal_load, hp, hv, hpos, ist, fst):
-    """(Re)build the three heaps from scratch, O(N log N)."""
-    hpos[:] = -1
-    ist[HEAP_SIZE] = 0
-    ist[UP_SIZE] = 0
-    ist[DOWN_SIZE] = 0
-    unit_load = True
-    for j in range(mu.size):
-        unit_load = unit_load and normal_load[j] == 1.0
-    for j in range(mu.size):
-        update_node(j, fst[THETA], a, g, mu, normal_load, unit_load, hp, hv, hpos, ist)
+        set_critical(heaps, j, dn, up)
 
 
 @kernel_jit(inline="always")
@@ -259,111 +218,65 @@ def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
 
 
 @kernel_jit(inline="always")
-def _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load, w,
-          ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
-    """Node i slips alone; a is updated on its block row; its threshold is redrawn."""
-    fd = mu_d * normal_load[i]
-    d = diagpos[i]  # the diagonal block K_ii
-    kxx = kblk[d, 0, 0]
-    kxy = kblk[d, 0, 1]
-    kyy = kblk[d, 1, 1]
-    if slip_mode == SLIP_EXACT:
-        dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
-        if nsteps < 0:
-            return False
-    else:
-        dux, duy = straight_slip(Fx, Fy, absF, absF, kxx, kxy, kyy, fd)
-    log_event(i, dux, duy, ist, fst, ev_i, ev_f)
-    u[i, 0] += dux
-    u[i, 1] += duy
-    for p in range(indptr[i], indptr[i + 1]):
-        j = indices[p]
-        # K is symmetric, so K_ji du_i = K_ij du_i with the stored row i.
-        a[j, 0] -= kblk[p, 0, 0] * dux + kblk[p, 0, 1] * duy
-        a[j, 1] -= kblk[p, 1, 0] * dux + kblk[p, 1, 1] * duy
-    fst[XG] += dux * w[i]
-    fst[YG] += duy * w[i]
-    redraw_threshold(i, mu, mu_buf, ist, fst, node_slips)
-    theta = fst[THETA]
-    for p in range(indptr[i], indptr[i + 1]):
-        update_node(indices[p], theta, a, g, mu, normal_load, unit_load, hp, hv, hpos, ist)
-    return True
+def slip_displacement(net, nodes, settings, i, theta, driving, s):
+    """The slip of node i alone, the others fixed: (ok, du_x, du_y).
 
-
-@kernel_jit()
-def _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min):
-    k = ist[REC]
-    out_n[k] = ist[N_SLIPS]
-    out_mu_max[k] = fst[MU_MAX]
-    out_xg[k] = fst[XG]
-    out_yg[k] = fst[YG]
-    out_records[k] = ist[N_RECORDS]
-    out_mu_mean[k], out_mu_min[k] = mu_stats(mu)
-    ist[REC] = k + 1
-
-
-@kernel_jit()
-def run_vec(
-    thetas, rec_times, mu, ist, fst, a, u, mu_buf, mu_d, max_slips, recompute_every, slip_mode,
-    indptr, indices, kblk, diagpos, g, normal_load, unit_load, w, hp, hv, hpos, aval_hist,
-    node_slips, ev_i, ev_f, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean, out_mu_min,
-):
-    """Advance a 2D network through ``thetas`` (units of Ntilde).
-
-    ``a``, ``u``, ``g`` have shape (N, 2); ``kblk`` (nnzb, 2, 2) holds the
-    blocks K_ij of the block-CSR rows (``indptr``, ``indices``), and
-    ``diagpos[i]`` the position of K_ii; ``unit_load`` is True when every
-    normal load is 1 (the array is then not read in the hot loop). The
-    heaps must have been built by :func:`init_vec_heaps`; an unstable initial
-    state (a large f_ext) is relaxed first.
+    ``settings.slip_mode`` picks the straight line or the exact 2D motion;
+    ok is False if the exact motion did not come to rest within its step
+    budget. A driving slip (``driving``) starts exactly at the threshold,
+    |F_i| = mu_s,i N_i, along the force computed at theta.
     """
-    steps = thetas.size - 1
-    open_initial_relaxation(ist)
-    while True:
-        while ist[HEAP_SIZE] > 0:
-            i = hp[0, 0]
-            theta = fst[THETA]
-            Fx = a[i, 0] + g[i, 0] * theta
-            Fy = a[i, 1] + g[i, 1] * theta
-            ist[AV_SLIPS] += 1
-            if ist[AV_SLIPS] > max_slips:
-                ist[ERR_NODE] = i
-                return AVALANCHE_LIMIT
-            st = buffers_low(ist, mu_buf, ev_i)
-            if st != DONE:
-                ist[AV_SLIPS] -= 1
-                return st
-            absF = math.sqrt(Fx * Fx + Fy * Fy)
-            if not _slip(i, Fx, Fy, absF, a, u, mu, indptr, indices, kblk, diagpos, g, normal_load, unit_load,
-                         w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos, node_slips, ev_i, ev_f):
-                ist[ERR_NODE] = i
-                return AVALANCHE_LIMIT
-        avalanche_done(ist, aval_hist, AV_SLIPS, IN_AVALANCHE)
-        # The t = 0 record is of the state after the initial relaxation.
-        if close_t0(ist, rec_times):
-            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records,
-                    out_mu_mean, out_mu_min)
-        if recompute_every > 0 and ist[SINCE_RECOMPUTE] >= recompute_every:
-            return RECOMPUTE
-        if ist[Q] >= steps:
-            return DONE
-        best, thc, _ = next_driving_event(thetas, ist, fst, hp, hv)
-        if best >= 0:
-            fst[THETA] = thc
-            st = buffers_low(ist, mu_buf, ev_i)
-            if st != DONE:
-                return st
-            # At theta_c, |F| = mu_s N exactly; its direction is computed.
-            lim = mu[best] * normal_load[best]
-            Fx = a[best, 0] + g[best, 0] * thc
-            Fy = a[best, 1] + g[best, 1] * thc
-            open_driving_event(thetas, thc, ist, fst)
-            if not _slip(best, Fx, Fy, lim, a, u, mu, indptr, indices, kblk, diagpos, g,
-                         normal_load, unit_load, w, ist, fst, mu_buf, mu_d, slip_mode, hp, hv, hpos,
-                         node_slips, ev_i, ev_f):
-                ist[ERR_NODE] = best
-                return AVALANCHE_LIMIT
-            continue
-        if end_step(thetas, rec_times, ist, fst):
-            _record(ist, fst, mu, out_n, out_mu_max, out_xg, out_yg, out_records, out_mu_mean,
-                    out_mu_min)
+    fd = settings.mu_d * net.normal_load[i]
+    d = net.diag[i]  # the diagonal block K_ii
+    K = net.K_blocks
+    kxx = K[d, 0, 0]
+    kxy = K[d, 0, 1]
+    kyy = K[d, 1, 1]
+    Fx = nodes.a[i, 0] + net.g[i, 0] * theta
+    Fy = nodes.a[i, 1] + net.g[i, 1] * theta
+    if settings.slip_mode == SLIP_EXACT:
+        dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
+        return nsteps >= 0, dux, duy
+    absF = nodes.mu[i] * net.normal_load[i] if driving else math.sqrt(Fx * Fx + Fy * Fy)
+    dux, duy = straight_slip(Fx, Fy, absF, absF, kxx, kxy, kyy, fd)
+    return True, dux, duy
+
+
+@kernel_jit(inline="always")
+def spread(net, a, i, dux, duy):
+    """The forces a_j of node i's neighbours (and its own) after it moved by (dux, duy): a -= K du."""
+    K = net.K_blocks
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        j = net.indices[p]
+        # K is symmetric, so K_ji du_i = K_ij du_i with the stored row i.
+        a[j, 0] -= K[p, 0, 0] * dux + K[p, 0, 1] * duy
+        a[j, 1] -= K[p, 1, 0] * dux + K[p, 1, 1] * duy
+
+
+@kernel_jit(inline="always")
+def move_node(net, st, nodes, i, dux, duy):
+    """Displace node i by (dux, duy): its force offsets on the block row of K, and the centre of mass."""
+    nodes.u[i, 0] += dux
+    nodes.u[i, 1] += duy
+    spread(net, nodes.a, i, dux, duy)
+    st.x_G += dux * net.w[i]
+    st.y_G += duy * net.w[i]
+
+
+@kernel_jit(inline="always")
+def pair_force(net, nodes, theta):
+    """The force along x on node 1 (the appendix's tilt test is for 1D pairs; the scene refuses it in 2D)."""
+    return nodes.a[1, 0] + net.g[1, 0] * theta
+
+
+@kernel_jit()
+def run_plane(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
+    """:func:`slidernet.kernels.network.run_network` on a 2D network (``net`` a Plane)."""
+    return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
+                       update_node, slip_displacement, move_node, pair_force)
+
+
+@kernel_jit()
+def init_plane_heaps(net, state, nodes, heaps):
+    """:func:`slidernet.kernels.network.init_heaps` on a 2D network."""
+    init_heaps(net, state, nodes, heaps, update_node)

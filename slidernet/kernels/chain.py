@@ -1,0 +1,88 @@
+"""The geometry of 1D networks: scalar forces, CSR rows of K.
+
+The force on node i is F_i = a_i + g_i theta, with a = -K u - g theta(0)
+(+ f_ext) updated incrementally on the CSR row of the slipped node. A node
+is stable while |F_i| <= mu_s,i N_i, i.e. while theta lies between its two
+critical values theta_dn,i <= theta <= theta_up,i (eq. `critique` for node i);
+these only change when the node or a neighbour slips.
+
+These are the pieces of :func:`slidernet.kernels.network.run_network` that
+depend on the dimension; the driving loop itself is shared with 2D
+networks (:mod:`slidernet.kernels.plane`). On a 2-node chain they perform
+the same floating-point operations as :func:`slidernet.kernels.pair.run_pair`.
+"""
+
+from __future__ import annotations
+
+from slidernet.kernels.heap import heap_set, set_critical
+from slidernet.kernels.network import init_heaps, run_network
+from slidernet.kernels.state import UNSTABLE, kernel_jit
+
+
+@kernel_jit(inline="always")
+def update_node(net, nodes, heaps, j, theta):
+    """Re-key node j in the three heaps after its force or threshold changed."""
+    a = nodes.a
+    g = net.g
+    F = abs(a[j] + g[j] * theta)
+    # With unit loads (the default) the load array stays out of the cache; mu * 1.0 is mu exactly.
+    lim = nodes.mu[j] if net.unit_load else nodes.mu[j] * net.normal_load[j]
+    # Most updated nodes are stable and out of the heap: skip the call then.
+    if F > lim or heaps.slot[j, UNSTABLE] >= 0:
+        heap_set(heaps, UNSTABLE, j, F / lim, F > lim)
+    gj = g[j]
+    if gj != 0.0:
+        # The two roots of |a_j + g_j theta| = mu_s,j N_j.
+        if gj > 0.0:
+            up = (lim - a[j]) / gj
+            dn = (-lim - a[j]) / gj
+        else:
+            up = (-lim - a[j]) / gj
+            dn = (lim - a[j]) / gj
+        set_critical(heaps, j, dn, up)
+
+
+@kernel_jit(inline="always")
+def slip_displacement(net, nodes, settings, i, theta, driving, s):
+    """The slip of node i alone, an undamped half-oscillation: (True, du, 0.0).
+
+    Delta u_i = 2 (|F_i| - mu_d N_i) sign(F_i) / K_ii (eq. `displacement`).
+    A driving slip (``driving``, theta moving with sign s) starts exactly at
+    the threshold, |F_i| = mu_s,i N_i, with the sign of g_i s.
+    """
+    if driving:
+        absF = nodes.mu[i] * net.normal_load[i]
+        F = absF if net.g[i] * s > 0.0 else -absF
+    else:
+        F = nodes.a[i] + net.g[i] * theta
+        absF = abs(F)
+    sgn = 1.0 if F > 0.0 else -1.0
+    return True, 2.0 * (absF - settings.mu_d * net.normal_load[i]) * sgn / net.K_diag[i], 0.0
+
+
+@kernel_jit(inline="always")
+def move_node(net, st, nodes, i, dux, duy):
+    """Displace node i by dux: its force offsets on the CSR row of K, and the centre of mass."""
+    nodes.u[i] += dux
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        nodes.a[net.indices[p]] -= net.K_data[p] * dux
+    st.x_G += dux * net.w[i]
+
+
+@kernel_jit(inline="always")
+def pair_force(net, nodes, theta):
+    """The spring force on node 1 of a 2-node chain, F_{1->2} (the appendix's tilt test reads it)."""
+    return nodes.a[1] + net.g[1] * theta
+
+
+@kernel_jit()
+def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
+    """:func:`slidernet.kernels.network.run_network` on a 1D network (``net`` a Chain)."""
+    return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
+                       update_node, slip_displacement, move_node, pair_force)
+
+
+@kernel_jit()
+def init_chain_heaps(net, state, nodes, heaps):
+    """:func:`slidernet.kernels.network.init_heaps` on a 1D network."""
+    init_heaps(net, state, nodes, heaps, update_node)

@@ -1,0 +1,165 @@
+"""The network kernel: one driving loop for 1D and 2D networks.
+
+:func:`run_network` advances any network through theta(t_q): it relaxes
+avalanches largest overload first, then jumps theta to the next node's
+critical value (eq. `critique`) or to the end of the thermal step. What
+depends on the dimension -- the force's norm, the roots of eq. `critique`,
+the slip, how a slip moves the forces -- comes in as four functions of the
+geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
+of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
+
+* ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heaps;
+* ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
+  slip of node i alone, ``(ok, du_x, du_y)``;
+* ``move_node(net, st, nodes, i, du_x, du_y)``: apply it to u, to the force
+  offsets of the row of K, and to the centre of mass;
+* ``pair_force(net, nodes, theta)``: the spring force on node 1 of a pair
+  (the appendix's tilt test).
+
+The loop is inlined (numba's ``inline="always"``) into each geometry's
+compiled kernel, :func:`~slidernet.kernels.chain.run_chain` and
+:func:`~slidernet.kernels.plane.run_plane`, which pass it their own
+functions: numba resolves the calls when it compiles the kernel, so each
+kernel runs as if the loop had been written for it alone.
+"""
+
+from __future__ import annotations
+
+from slidernet.kernels.heap import (
+    avalanche_done,
+    buffers_low,
+    close_t0,
+    end_step,
+    heap_clear,
+    log_event,
+    next_driving_event,
+    open_driving_event,
+    open_initial_relaxation,
+    redraw_threshold,
+    write_output,
+)
+from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, RECOMPUTE, UNSTABLE, kernel_jit
+from slidernet.kernels.tilt import tilt_sample
+
+
+@kernel_jit(inline="always")
+def init_heaps(net, state, nodes, heaps, update_node):
+    """(Re)build the three heaps from scratch, O(N log N)."""
+    st = state[0]
+    heap_clear(heaps)
+    for j in range(nodes.mu.size):
+        update_node(net, nodes, heaps, j, st.theta)
+
+
+@kernel_jit(inline="always")
+def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, update_node, slip_displacement,
+              move_node):
+    """Node i slips alone; its threshold is redrawn and it and its neighbours are re-keyed.
+
+    Returns False if the slip did not come to rest (the exact 2D slip's step budget).
+    """
+    theta = st.theta
+    ok, dux, duy = slip_displacement(net, nodes, settings, i, theta, driving, s)
+    if not ok:
+        return False
+    log_event(st, catalogue, i, dux, duy)
+    move_node(net, st, nodes, i, dux, duy)
+    redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        update_node(net, nodes, heaps, net.indices[p], theta)
+    return True
+
+
+@kernel_jit(inline="always")
+def _tilt(net, st, nodes, draws, out, settings, pair_force):
+    """The appendix's tilt test on the current state of a pair (``settings.do_tilt``)."""
+    return tilt_sample(st, draws, out, st.next_out, pair_force(net, nodes, st.theta), nodes.mu[0],
+                       nodes.mu[1], settings.mu_d)
+
+
+@kernel_jit(inline="always")
+def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings, update_node,
+                slip_displacement, move_node, pair_force):
+    """Advance a network through ``thetas`` (units of Ntilde); returns a status code.
+
+    Parameters
+    ----------
+    thetas : ndarray, shape (steps + 1,)
+        theta(t_q) / Ntilde; the run stops at the end of the array.
+    out_steps : ndarray of int64, shape (T,)
+        The steps at which the state is written to ``out``.
+    net : Chain or Plane
+        The network's operators; their type picks the geometry.
+    state : ndarray of dtype STATE, shape (1,)
+        The realization's scalars.
+    nodes : Nodes
+        The per-node state.
+    heaps : Heaps
+        The three heaps, built by :func:`init_heaps`.
+    draws : Draws
+        Thresholds to hand out, one per slip (and the tilt test's draws).
+    catalogue : Catalogue
+        The event catalogue's buffer (0 rows when it is off).
+    out : Series
+        The output series.
+    settings : Settings
+        mu_d, max_slips, recompute_every, do_tilt (a 1D pair only), slip_mode.
+
+    Returns ``DONE`` at the end of ``thetas``, ``NEED_MU``, ``NEED_TILT`` or
+    ``NEED_EVENTS`` when a buffer runs low, ``RECOMPUTE`` every
+    ``recompute_every`` slips (0: never) so that the caller recomputes the
+    forces from the displacements and rebuilds the heaps, and
+    ``AVALANCHE_LIMIT`` (node in ``err_node``). An unstable initial state (a
+    large f_ext) is relaxed first, as part of t = 0.
+    """
+    st = state[0]
+    steps = thetas.size - 1
+    open_initial_relaxation(st, heaps)
+    while True:
+        while heaps.size[UNSTABLE] > 0:
+            i = heaps.node[UNSTABLE, 0]
+            st.av_slips += 1
+            if st.av_slips > settings.max_slips:
+                st.err_node = i
+                return AVALANCHE_LIMIT
+            # The buffer check comes first: a kernel that returns after the
+            # tilt sample would take it again on re-entry.
+            status = buffers_low(st, draws, catalogue)
+            if status == DONE and settings.do_tilt:
+                status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            if status != DONE:
+                st.av_slips -= 1
+                return status
+            if not slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, False, 0.0, update_node,
+                             slip_displacement, move_node):
+                st.err_node = i
+                return AVALANCHE_LIMIT
+        avalanche_done(st, nodes.avalanche_count)
+        if st.started == 0 and settings.do_tilt:
+            # The tilt test before each rearrangement needs f_ext = 0, so
+            # there was no initial relaxation: this is the state at t = 0.
+            status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            if status != DONE:
+                return status
+        if close_t0(st, out_steps):
+            write_output(st, nodes.mu, out)
+        if settings.recompute_every > 0 and st.since_recompute >= settings.recompute_every:
+            return RECOMPUTE
+        if st.q >= steps:
+            return DONE
+        best, thc, s = next_driving_event(st, heaps, thetas)
+        if best >= 0:
+            st.theta = thc
+            status = buffers_low(st, draws, catalogue)
+            if status == DONE and settings.do_tilt:
+                status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            if status != DONE:
+                return status
+            open_driving_event(st, thetas, thc)
+            if not slip_node(net, st, nodes, heaps, draws, catalogue, settings, best, True, s, update_node,
+                             slip_displacement, move_node):
+                st.err_node = best
+                return AVALANCHE_LIMIT
+            continue
+        if end_step(st, thetas, out_steps):
+            write_output(st, nodes.mu, out)
