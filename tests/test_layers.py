@@ -71,3 +71,39 @@ def test_imports_point_down(path):
 def test_every_stage_is_ranked():
     stages = {_stage(_module_name(p)) for p in MODULES}
     assert stages <= set(RANK), stages - set(RANK)
+
+
+# The values of ``solver.kernel``. The configuration checks and picks them (config.py: the key's checks and
+# choose_kernel, the one rule), the scene checks an explicit choice against its network, and
+# solver/backends.py maps the choice to a backend (BACKENDS); no other module may branch on one.
+KERNEL_NAMES = {"pair", "csr", "vec"}
+ALLOWED = {"config.py", "solver/scene.py", "solver/backends.py"}
+
+
+def _kernel_name_comparisons(path: Path) -> list[int]:
+    """Lines of ``path`` that compare something with a kernel's name (==, !=, in, match cases)."""
+    lines = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Compare):
+            names = [c for c in [node.left, *node.comparators] if isinstance(c, ast.Constant)]
+            names += [e for c in node.comparators if isinstance(c, (ast.Tuple, ast.List, ast.Set)) for e in c.elts
+                      if isinstance(e, ast.Constant)]
+            if any(c.value in KERNEL_NAMES for c in names):
+                lines.append(node.lineno)
+        elif isinstance(node, ast.MatchValue) and isinstance(node.value, ast.Constant):
+            if node.value.value in KERNEL_NAMES:
+                lines.append(node.lineno)
+    return lines
+
+
+def test_only_the_configuration_and_the_backend_table_branch_on_a_kernel_name():
+    found = {str(p.relative_to(ROOT)): lines for p in sorted(ROOT.rglob("*.py"))
+             if str(p.relative_to(ROOT)) not in ALLOWED and (lines := _kernel_name_comparisons(p))}
+    assert found == {}, f"branches on a kernel's name outside {sorted(ALLOWED)}: {found}"
+
+
+def test_the_kernel_name_scan_finds_a_branch(tmp_path):
+    # The scan itself can fail: a planted branch is found.
+    planted = tmp_path / "planted.py"
+    planted.write_text('if scene.kernel == "vec":\n    pass\nok = kernel in ("csr", "other")\n')
+    assert _kernel_name_comparisons(planted) == [1, 3]
