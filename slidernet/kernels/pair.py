@@ -48,6 +48,7 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
     st = state[0]
     mu_d = settings.mu_d
     do_tilt = settings.do_tilt
+    max_slips = settings.max_slips
     steps = thetas.size - 1
     if st.started == 0:
         if do_tilt:
@@ -83,7 +84,7 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 continue
             aFi = abs(F)
             av += 1
-            if av > settings.max_slips:
+            if av > max_slips:
                 st.err_node = i
                 status = AVALANCHE_LIMIT
                 break
