@@ -65,6 +65,7 @@ from scipy import special, stats
 
 from slidernet._validation import checked_output
 from slidernet.errors import ConfigError, param_error
+from slidernet.kernels import draws
 
 # The least probability a law may put above mu_d (check_mu_d): rejection
 # sampling then costs at most 1000 draws per accepted threshold.
@@ -199,6 +200,11 @@ class Distribution(abc.ABC):
     # Every built-in is conditioned on mu_s > mu_d by TruncatedBelow (rejection):
     # a law whose support starts above mu_d loses nothing.
     truncate_below_mu_d: ClassVar[bool] = True
+
+    def compiled_law(self) -> tuple[int, float, float, float] | None:
+        """``(code, a, b, c)`` of :mod:`slidernet.kernels.draws` if compiled code draws this law to the
+        bit of :meth:`sample`, else None (the default: plugins keep the batched path)."""
+        return None
 
     @abc.abstractmethod
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
@@ -368,6 +374,9 @@ class Gaussian(Distribution):
         if self.mean <= mu_d:
             raise param_error("mean", "gaussian", f"> mu_d = {mu_d!r}", self.mean)
 
+    def compiled_law(self) -> tuple[int, float, float, float]:
+        return draws.GAUSSIAN, self.std, self.mean, 0.0
+
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """``size`` draws, shape ``(size,)``."""
         x = rng.standard_normal(size)
@@ -433,6 +442,9 @@ class Uniform(Distribution):
     def support(self) -> tuple[float, float]:
         """(low, high)."""
         return self.low, self.high
+
+    def compiled_law(self) -> tuple[int, float, float, float]:
+        return draws.UNIFORM, self.low, self.high, 0.0
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """``size`` draws, shape ``(size,)``."""
@@ -508,6 +520,9 @@ class Weibull(Distribution):
 
     def _z(self, x: ArrayLike) -> np.ndarray:
         return (np.maximum(np.asarray(x, dtype=float) - self.loc, 0.0) / self.scale) ** self.shape
+
+    def compiled_law(self) -> tuple[int, float, float, float]:
+        return draws.WEIBULL, self.loc, self.scale, self.shape
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """``size`` draws, shape ``(size,)``."""
@@ -640,6 +655,9 @@ class Exponential(Distribution):
 
     def _z(self, x: ArrayLike) -> np.ndarray:
         return np.maximum(np.asarray(x, dtype=float) - self.loc, 0.0) / self.scale
+
+    def compiled_law(self) -> tuple[int, float, float, float]:
+        return draws.EXPONENTIAL, self.loc, self.scale, 0.0
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """``size`` draws, shape ``(size,)``."""
@@ -1119,6 +1137,11 @@ class TruncatedBelow(Distribution):
                 "mass there; p(mu_s) must vanish for mu_s <= mu_d."
             )
 
+    def compiled_law(self) -> tuple[int, float, float, float] | None:
+        """The law's compiled draws, for a built-in that has them (a plugin's ``sample`` is always called)."""
+        law = getattr(self.dist, "compiled_law", None)
+        return law() if self.truncate and isinstance(self.dist, Distribution) and law is not None else None
+
     def accepted(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """The draws strictly above ``lower`` among ``size`` draws of the plugin, in their order.
 
@@ -1309,6 +1332,9 @@ class TruncatedStream:
         self.dist = dist
         self.rng = rng
         self._surplus = np.empty(0)
+        # A built-in law with compiled draws is drawn one value at a time: the same values, with
+        # no surplus, about 4 times faster (slidernet.kernels.draws).
+        self._compiled = dist.compiled_law() if isinstance(dist, TruncatedBelow) else None
 
     @property
     def surplus(self) -> np.ndarray:
@@ -1342,6 +1368,10 @@ class TruncatedStream:
         size = int(size)
         if size < 0:
             raise ValueError(f"The 'size' parameter of TruncatedStream.take must be >= 0. Got {size} instead.")
+        if self._compiled is not None and not self._surplus.size:
+            out = np.empty(size)
+            draws.fill_truncated(self.rng, out, *self._compiled, self.dist.lower)
+            return out
         parts = [self._surplus] if self._surplus.size else []
         have = self._surplus.size
         while have < size:

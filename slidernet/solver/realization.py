@@ -42,9 +42,10 @@ class Realization:
     2. ``thresholds``: a :class:`~slidernet.plugins.distributions.TruncatedStream`
        (``draws["thresholds"]``): the plugin's ``sample(rng, RAW_CHUNK)``
        called again and again with the fixed size ``RAW_CHUNK``, the values
-       at or below mu_d dropped, the rest laid end to end. The first N values
-       are the initial thresholds (node order), then one value per slip, in
-       the order of the slips.
+       at or below mu_d dropped, the rest laid end to end (built-in laws with
+       compiled draws, :mod:`slidernet.kernels.draws`, give the same values
+       one at a time). The first N values are the initial thresholds (node
+       order), then one value per slip, in the order of the slips.
     3. ``tilt``: another ``TruncatedStream`` (``draws["tilt"]``), the same way:
        the thresholds the tilt tests redraw, in the order the tests (one
        after the other) read them.
