@@ -105,6 +105,56 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
             theta_b = thetas[q + 1]
             theta_a = thetas[q]
             s = 1.0 if theta_b > theta_a else (-1.0 if theta_b < theta_a else 0.0)
+            if s != 0.0 and not do_tilt:
+                # The common case as a tight loop: the driving events of this step, one slip
+                # each, until the step ends, the buffer runs out or a slip leaves a slider
+                # unstable (then the general loop below takes over). It runs in coordinates
+                # multiplied by s = +-1 (v = s u, vt = s theta, xr = s x_G), where eq.
+                # `critique` reads s theta_c = mu_s,i + v and a slip adds 2 (mu_s,i - mu_d) to
+                # v whichever slider slips: negation is exact and commutes with rounding, so
+                # these are the general path's bits, with no multiplication by s on u's chain
+                # of dependent operations. Which slider slips is a coin toss: a select, not a
+                # branch.
+                v = s * u
+                vt = s * theta
+                vb = s * theta_b
+                xr = s * xg
+                d0 = 2.0 * (mu0 * 1.0 - mu_d * 1.0)
+                d1 = 2.0 * (mu1 * 1.0 - mu_d * 1.0)
+                while p < nbuf:
+                    t0 = mu0 * 1.0 + v
+                    t1 = mu1 * 1.0 + v
+                    one = t1 < t0
+                    tc = t1 if one else t0
+                    if tc < vt:
+                        tc = vt  # rounding: the slider is already at its threshold
+                    if vb < tc:
+                        break
+                    vt = tc
+                    d = d1 if one else d0
+                    v = v + d
+                    xr += (d if one else -d) * 0.5
+                    new = mu_draws[p]
+                    p += 1
+                    nrec += new > mumax
+                    d_new = 2.0 * (new * 1.0 - mu_d * 1.0)
+                    mu1 = new if one else mu1
+                    mu0 = mu0 if one else new
+                    d1 = d_new if one else d1
+                    d0 = d0 if one else d_new
+                    mumax = max(mu0, mu1)
+                    n += 1
+                    nev += 1
+                    av = 0
+                    aF = abs(vt - v)
+                    if aF > mu0 * 1.0 or aF > mu1 * 1.0:
+                        pending = 1
+                        break
+                u = s * v
+                theta = s * vt
+                xg = s * xr
+                if pending:
+                    continue
             i = -1
             thc = theta
             if s != 0.0:
