@@ -30,16 +30,20 @@ def update_node(net, nodes, heaps, j, theta):
     # Most updated nodes are stable and out of the heap: skip the call then.
     if F > lim or heaps.slot[j, UNSTABLE] >= 0:
         heap_set(heaps, UNSTABLE, j, F / lim, F > lim)
-    gj = g[j]
-    if gj != 0.0:
-        # The two roots of |a_j + g_j theta| = mu_s,j N_j.
-        if gj > 0.0:
-            up = (lim - a[j]) / gj
-            dn = (-lim - a[j]) / gj
-        else:
-            up = (-lim - a[j]) / gj
-            dn = (lim - a[j]) / gj
+    if g[j] != 0.0:
+        dn, up = critical_roots(net, nodes, j)
         set_critical(heaps, j, dn, up)
+
+
+@kernel_jit(inline="always")
+def critical_roots(net, nodes, j):
+    """(theta_dn, theta_up) of a driven node j: the two roots of |a_j + g_j theta| = mu_s,j N_j."""
+    a = nodes.a[j]
+    gj = net.g[j]
+    lim = nodes.mu[j] if net.unit_load else nodes.mu[j] * net.normal_load[j]
+    if gj > 0.0:
+        return (-lim - a) / gj, (lim - a) / gj
+    return (lim - a) / gj, (-lim - a) / gj
 
 
 @kernel_jit(inline="always")
@@ -79,7 +83,7 @@ def pair_force(net, nodes, theta):
 def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`slidernet.kernels.network.run_network` on a 1D network (``net`` a Chain)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, slip_displacement, move_node, pair_force)
+                       update_node, critical_roots, slip_displacement, move_node, pair_force)
 
 
 @kernel_jit()

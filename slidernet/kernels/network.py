@@ -4,11 +4,12 @@
 avalanches largest overload first, then jumps theta to the next node's
 critical value (eq. `critique`) or to the end of the thermal step. What
 depends on the dimension -- the force's norm, the roots of eq. `critique`,
-the slip, how a slip moves the forces -- comes in as four functions of the
+the slip, how a slip moves the forces -- comes in as five functions of the
 geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
 of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 
 * ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heaps;
+* ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
 * ``move_node(net, st, nodes, i, du_x, du_y)``: apply it to u, to the force
@@ -31,6 +32,7 @@ from slidernet.kernels.heap import (
     close_t0,
     end_step,
     heap_clear,
+    heap_set,
     log_event,
     next_driving_event,
     open_driving_event,
@@ -38,7 +40,7 @@ from slidernet.kernels.heap import (
     redraw_threshold,
     write_output,
 )
-from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, RECOMPUTE, UNSTABLE, kernel_jit
+from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, UNSTABLE, UP, kernel_jit
 from slidernet.kernels.tilt import tilt_sample
 
 
@@ -71,6 +73,34 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
 
 
 @kernel_jit(inline="always")
+def turn(st, net, nodes, heaps, thetas, critical_roots):
+    """Make the driving heap of theta's direction in step q the active one, up to date.
+
+    When theta turns, the nodes re-keyed since the last turn get their key in
+    the heap that becomes active (their key in the other one is up to date:
+    it was the active heap). O(stale nodes log N), once per turn, instead of
+    a second sift at every update.
+    """
+    q = st.q
+    rising = thetas[q + 1] > thetas[q]
+    if not rising and not thetas[q + 1] < thetas[q]:
+        return  # theta stands still: no driving event in this step
+    want = UP if rising else DOWN
+    if heaps.active[0] == want:
+        return
+    heaps.active[0] = want
+    for k in range(heaps.n_stale[0]):
+        j = heaps.stale_nodes[k]
+        heaps.stale[j] = 0
+        dn, up = critical_roots(net, nodes, j)
+        if want == UP:
+            heap_set(heaps, UP, j, -up, True)
+        else:
+            heap_set(heaps, DOWN, j, dn, True)
+    heaps.n_stale[0] = 0
+
+
+@kernel_jit(inline="always")
 def _tilt(net, st, nodes, draws, out, settings, pair_force):
     """The appendix's tilt test on the current state of a pair (``settings.do_tilt``)."""
     return tilt_sample(st, draws, out, st.next_out, pair_force(net, nodes, st.theta), nodes.mu[0],
@@ -79,7 +109,7 @@ def _tilt(net, st, nodes, draws, out, settings, pair_force):
 
 @kernel_jit(inline="always")
 def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings, update_node,
-                slip_displacement, move_node, pair_force):
+                critical_roots, slip_displacement, move_node, pair_force):
     """Advance a network through ``thetas`` (units of Ntilde); returns a status code.
 
     Parameters
@@ -147,6 +177,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             return RECOMPUTE
         if st.q >= steps:
             return DONE
+        turn(st, net, nodes, heaps, thetas, critical_roots)
         best, thc, s = next_driving_event(st, heaps, thetas)
         if best >= 0:
             st.theta = thc

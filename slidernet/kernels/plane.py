@@ -204,6 +204,13 @@ def update_node(net, nodes, heaps, j, theta):
 
 
 @kernel_jit(inline="always")
+def critical_roots(net, nodes, j):
+    """(theta_dn, theta_up) of a driven node j: the roots of |a_j + g_j theta| = mu_s,j N_j."""
+    lim = nodes.mu[j] if net.unit_load else nodes.mu[j] * net.normal_load[j]
+    return critical_thetas(nodes.a[j, 0], nodes.a[j, 1], net.g[j, 0], net.g[j, 1], lim)
+
+
+@kernel_jit(inline="always")
 def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
     """The straight-line slip: 2 (mag - fd) / k_eff along F / norm, k_eff = e^T K_ii e.
 
@@ -273,7 +280,7 @@ def pair_force(net, nodes, theta):
 def run_plane(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`slidernet.kernels.network.run_network` on a 2D network (``net`` a Plane)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, slip_displacement, move_node, pair_force)
+                       update_node, critical_roots, slip_displacement, move_node, pair_force)
 
 
 @kernel_jit()

@@ -146,17 +146,29 @@ class Heaps(NamedTuple):
     so that sifting reads contiguous memory; ``slot[node, w]`` is its slot or
     -1, node-major so that the W slots of a node share a cache line;
     ``size[w]`` is the size of heap w.
+
+    Of the two driving heaps (``UP``, ``DOWN``) only the one theta is moving
+    along, ``active[0]``, is kept up to date at every slip; a node re-keyed
+    meanwhile is listed in ``stale_nodes[:n_stale[0]]`` (and marked in
+    ``stale``), and the other heap is brought up to date for those nodes
+    when theta turns (:func:`slidernet.kernels.network.turn`).
     """
 
     node: np.ndarray  # (W, N) int64
     key: np.ndarray  # (W, N) float64
     slot: np.ndarray  # (N, W) int64
     size: np.ndarray  # (W,) int64
+    active: np.ndarray  # (1,) int64: the driving heap kept up to date (UP or DOWN)
+    stale: np.ndarray  # (N,) uint8: 1 if the other driving heap's key of the node is out of date
+    stale_nodes: np.ndarray  # (N,) int64: those nodes, in the order they were marked
+    n_stale: np.ndarray  # (1,) int64: how many
 
     @classmethod
     def empty(cls, n_heaps: int, n_nodes: int) -> Heaps:
         return cls(np.zeros((n_heaps, n_nodes), np.int64), np.zeros((n_heaps, n_nodes)),
-                   np.full((n_nodes, n_heaps), -1, np.int64), np.zeros(n_heaps, np.int64))
+                   np.full((n_nodes, n_heaps), -1, np.int64), np.zeros(n_heaps, np.int64),
+                   np.full(1, UP, np.int64), np.zeros(n_nodes, np.uint8), np.zeros(n_nodes, np.int64),
+                   np.zeros(1, np.int64))
 
 
 class Draws(NamedTuple):
