@@ -363,7 +363,26 @@ def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     # from logit(eps) to logit(1 - eps); the first edge keeps F^m <= eps.
     logit_eps = log_eps_lo - math.log1p(-_TAIL_EPS)
     levels = np.linspace(logit_eps, -logit_eps, _N_PANELS + 1)
-    m_col = m_unique[:, None]
+    # Each m is integrated on its own (the bisection stops element by element),
+    # so chunks give the same bits as one batch; they keep the work arrays, of
+    # _N_PANELS * _PANEL_ORDER values per m, at a few MB (one batch of the
+    # paper's 50 500 values of n took 2.8 GB).
+    mean = np.empty(m_unique.size)
+    var = np.empty(m_unique.size)
+    for start in range(0, m_unique.size, _CHUNK):
+        part = slice(start, start + _CHUNK)
+        mean[part], var[part] = _moments_on_panels(dist, m_unique[part], a, b, levels)
+    shape = n_arr.shape
+    return mean[inverse].reshape(shape), np.sqrt(var)[inverse].reshape(shape)
+
+
+_CHUNK = 256  # values of m integrated at a time by mu_max_moments
+
+
+def _moments_on_panels(dist: Any, m: np.ndarray, a: float, b: float,
+                       levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(mean, variance) of the max of m draws for each m, on the panels of :func:`mu_max_moments`."""
+    m_col = m[:, None]
 
     def at_or_below_level(x: np.ndarray) -> np.ndarray:
         log_g = m_col * _log_cdf(dist, x)  # log F^m
@@ -371,7 +390,7 @@ def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
             logit = log_g - np.log(-np.expm1(log_g))
         return logit <= levels
 
-    lo, hi = _bisect(at_or_below_level, a, b, (m_unique.size, levels.size))
+    lo, hi = _bisect(at_or_below_level, a, b, (m.size, levels.size))
     edges = np.concatenate([lo[:, :1], hi[:, 1:]], axis=1)
     # Where F jumps across several levels at once (an atom), neighbouring edges
     # end at the same point, up to an ulp; keep them ordered.
@@ -381,14 +400,11 @@ def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     t, w = _gauss_legendre(_PANEL_ORDER)
     half = (0.5 * np.diff(edges, axis=1))[:, :, None]
     x = edges[:, :-1, None] + half * (t + 1.0)
-    survival = -np.expm1(m_unique[:, None, None] * _log_cdf(dist, x))  # P(max > x)
+    survival = -np.expm1(m[:, None, None] * _log_cdf(dist, x))  # P(max > x)
     weights = half * w
     above = (weights * survival).sum(axis=(1, 2))  # E[X] - x_lo
     second = (weights * 2.0 * (x - x_lo[:, None, None]) * survival).sum(axis=(1, 2))  # E[(X - x_lo)^2]
-    mean = x_lo + above
-    var = np.maximum(second - above**2, 0.0)
-    shape = n_arr.shape
-    return mean[inverse].reshape(shape), np.sqrt(var)[inverse].reshape(shape)
+    return x_lo + above, np.maximum(second - above**2, 0.0)
 
 
 def mu_max_leading(mu_s_mean: float, sigma_mu: float, n: ArrayLike) -> np.ndarray:
