@@ -1,35 +1,67 @@
-"""slidernet against plain-C yardsticks, in the same run: the performance table of the README.
+"""slidernet against two plain-C yardsticks in the same run: one Markdown table of same-run ratios.
 
-    python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--paper] [--core 1] [--csv PATH]
+    python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--sizes L ...] [--core 1] [--csv PATH]
+                                    [--no-delaunay] [--paper]
 
 The yardsticks are two plain C programs that solve the same model the
-straightforward way (a two-slider loop and a triangular-lattice solver).
-They are not part of slidernet: point ``--anchors`` (or the environment
-variable ``SLIDERNET_ANCHORS``) at the folder that holds
-``twoslider_loop.c`` and ``lattice.c``. The script builds them with
-``cc -O3 -march=native`` in a temporary folder. Without a compiler or
-without the folder it says so and prints slidernet's figures alone, the
-ratio column reading "skipped".
+straightforward way, on one core: ``twoslider_loop.c`` (the paper's two
+sliders) and ``lattice.c`` (a triangular lattice with free boundaries). They
+are not part of slidernet and do not ship with it: point ``--anchors`` (or
+the environment variable ``SLIDERNET_ANCHORS``) at the folder that holds
+them. The script builds them with ``cc -O3 -march=native`` in a temporary
+folder. Without the folder or without a C compiler it says so in one line
+and prints slidernet's figures alone, the ratio column reading
+"skipped (no anchors)" or "skipped (no C compiler)".
 
-Every slidernet workload runs in a fresh child process pinned to one core
-(``--core``), so that its peak resident memory (``ru_maxrss``) is its own,
-and the C run of the same workload follows it on the same core: the ratio
-is a same-minute ratio. The workloads (the targets of the performance issue):
+Absolute rates move by tens of percent from one machine or minute to the
+next; a ratio measured in the same minute on the same core does not. Every
+slidernet workload therefore runs in a fresh Python process pinned to one
+core (``--core``, ``os.sched_setaffinity``), and the C run of the same
+workload follows it on the same core. Each process's peak resident memory
+and CPU time come from ``os.wait4``, so they are that process's own. In
+every slidernet process the compiled kernels are first loaded (numba's disk
+cache) on a tiny scene, untimed.
 
-1. two sliders at the paper's setting (mu_d 0.5, Gaussian thresholds 0.6 +-
-   0.01, Ntilde 1e-7, sigma_theta 1e-6), 10 realizations, draws included;
-2. the same with the tilt test before every rearrangement (mu_eff);
-3. the same on 2 cores (2 spawned workers) against 1;
-4. triangular 32 x 32, sigma_theta / Ntilde = 1, 2000 steps;
-5. triangular 1000 x 1000, 20 steps: setup, kernel alone, both, peak memory;
-6. the rate at 1e6 nodes over the rate at 1e3 (kernel alone);
-7. an irregular (Delaunay) network of 1e6 nodes, 2 steps (every node is driven: about
-   2e7 slips a step), against row 5;
-8. with ``--paper``: ``slidernet paper`` (full preset, 2 cores), wall time
-   and peak memory (about 2 minutes).
+The rows (rates in millions of rearrangements, i.e. slips, per second):
 
-``--quick`` shortens every run (smoke test; the ratios are then noisy).
-Rates are M rearrangements (slips) per second.
+1. two sliders at the paper's setting: mu_d 0.5, Gaussian thresholds
+   (0.6, 0.01), Ntilde 1e-7, sigma_theta 1e-6 (``gaussian_steps``),
+   10 realizations x 100 000 steps, the drawing of the thresholds and of
+   theta included, against ``twoslider_loop 0.5 0.6 0.01 1e-7 1e-6 100000
+   10 1 0`` (10 realizations, seed 1; its last line gives the mean n and
+   the mean mu_max at the last step);
+2. the same with the virtual tilt test before every rearrangement
+   (observable ``mu_eff``): slidernet alone, no C counterpart;
+3. 20 realizations of row 1's run through ``slidernet.run`` with 2 worker
+   processes (``execution.workers = 2``) against 1: the speed-up, with the
+   same total n checked (not pinned: it uses two cores);
+4. triangular 32 x 32, Ntilde = sigma_theta = 1e-7, 2000 steps, kernel
+   alone, against ``lattice 32 32 1e-7 1e-7 2000 1``;
+5. triangular L x L for each L of ``--sizes`` (default 1000), 20 steps: the
+   rate with the setup included and of the kernel alone, the setup seconds
+   (slidernet: building the scene, then the realization: theta(t), the
+   thresholds, forces and heaps) and the peak resident memory of the
+   process, against ``lattice L L 1e-7 1e-7 20 1``;
+6. the rate at the largest L over the rate at 32 x 32 (about 1e3 nodes),
+   slidernet's and the C yardstick's;
+7. slidernet alone: an irregular (Delaunay) network with as many nodes as
+   the largest lattice, 2 steps (every node is driven: about 20 N slips a
+   step), its kernel rate against the triangular one of row 5, its setup and
+   peak memory (``--no-delaunay`` leaves it out: about 45 s at 1e6);
+8. with ``--paper``: ``slidernet paper`` (full preset, all cores), wall time
+   and the peak resident memory of its largest process (about 2 minutes).
+
+The target column holds the performance issue's targets (for a ratio,
+slidernet / C). Two columns show that both sides simulate the same thing: the slips (total
+rearrangements) and the mean mu (the mean of the final thresholds mu_s over
+the nodes; for two sliders, the mean over realizations of mu_max at the last
+step). The random streams differ, so the counts agree statistically, not to
+the bit: with 20 steps of a large lattice the work depends on the 20 draws
+of theta and differs by tens of percent between seeds.
+
+``--quick`` is a smoke run (10 000 steps for two sliders, 200 steps at
+32 x 32, ``--sizes 100``): its ratios are noisy. ``--csv PATH`` writes one
+line per row, with the numbers unformatted.
 """
 
 from __future__ import annotations
@@ -37,9 +69,9 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import re
-import resource
 import shutil
 import subprocess
 import sys
@@ -48,236 +80,429 @@ import time
 from pathlib import Path
 from typing import Any
 
-HERE = Path(__file__).resolve().parent
-
+# The paper's two sliders; the lattice yardstick has mu_d = 0.5 and thresholds N(0.6, 0.01) built in.
 PAIR = {"mu_d": 0.5, "mean": 0.6, "std": 0.01, "Ntilde": 1e-7, "sigma_theta": 1e-6}
+LATTICE = {"Ntilde": 1e-7, "sigma_theta": 1e-7}
+SMALL = 32  # the ~1e3-node lattice of rows 4 and 6
 
 
 # ---------------------------------------------------------------------------
-# the workloads, run in child processes
+# slidernet's workloads; each runs in a child process (``--child NAME JSON``) and returns a dict
 
 
-def _pair_config(steps: int, realizations: int, mu_eff: bool) -> Any:
-    from slidernet.config import load_config
+def _friction() -> dict[str, Any]:
+    return {"mu_d": PAIR["mu_d"], "static": {"name": "gaussian", "mean": PAIR["mean"], "std": PAIR["std"]}}
 
-    return load_config({
-        "steps": steps, "realizations": realizations,
-        "observables": ["n", "mu_max", "x_G", "mu_eff"] if mu_eff else ["n", "mu_max", "x_G"],
-        "network": {"Ntilde": PAIR["Ntilde"]},
+
+def _pair_config(steps: int, realizations: int = 1, tilt: bool = False) -> dict[str, Any]:
+    return {
+        "seed": 1, "steps": steps, "realizations": realizations,
+        "observables": ["n", "mu_max", "x_G"] + (["mu_eff"] if tilt else []),
+        "network": {"kind": "two_slider", "Ntilde": PAIR["Ntilde"]},
+        "friction": _friction(),
         "driver": {"name": "gaussian_steps", "sigma_theta": PAIR["sigma_theta"]},
-        "friction": {"mu_d": PAIR["mu_d"],
-                     "static": {"name": "gaussian", "mean": PAIR["mean"], "std": PAIR["std"]}},
-    })
+    }
 
 
-def _simulate(args: tuple[Any, int]) -> int:
-    from slidernet.solver import simulate
-
-    scene, seed = args
-    import numpy as np
-
-    return int(simulate(scene, np.random.SeedSequence(seed))["n"][-1])
-
-
-def child_pair(steps: int, realizations: int, mu_eff: bool, workers: int) -> dict[str, float]:
-    """Rearrangements per second of ``realizations`` runs, on ``workers`` processes (draws included)."""
-    import numpy as np
-
-    from slidernet.solver import Realization, Scene, simulate
-
-    scene = Scene.from_config(_pair_config(steps, realizations, mu_eff))
-    Realization(scene, np.random.SeedSequence(0)).advance(2)  # load the compiled kernels, untimed
-    jobs = [(scene, seed) for seed in range(1, realizations + 1)]
-    if workers == 1:
-        t0 = time.perf_counter()
-        n = sum(int(simulate(scene, np.random.SeedSequence(s))["n"][-1]) for _, s in jobs)
-        wall = time.perf_counter() - t0
-    else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            list(pool.map(_simulate, [(scene, 0)] * workers))  # start, import, load kernels: untimed
-            t0 = time.perf_counter()
-            n = sum(pool.map(_simulate, jobs))
-            wall = time.perf_counter() - t0
-    return {"slips": n, "seconds": wall, "rate": n / wall / 1e6}
+def _lattice_config(size: int, steps: int, kind: str = "triangular") -> dict[str, Any]:
+    network = {"kind": "triangular", "shape": [size, size]} if kind == "triangular" else \
+        {"kind": "irregular", "n": size * size}
+    return {
+        "steps": steps, "record": "log",
+        "network": {**network, "Ntilde": LATTICE["Ntilde"]},
+        "friction": _friction(),
+        "driver": {"name": "gaussian_steps", "sigma_theta": LATTICE["sigma_theta"]},
+    }
 
 
-def child_network(kind: str, size: int, steps: int) -> dict[str, float]:
-    """Setup (config to the first kernel call) and kernel time of one realization."""
+def _rss_GB() -> float:
+    """Resident memory of this process now (Linux), in GB; nan elsewhere."""
+    try:
+        match = re.search(r"^VmRSS:\s+(\d+) kB", Path("/proc/self/status").read_text(), re.MULTILINE)
+    except OSError:
+        return math.nan
+    return int(match.group(1)) * 1024 / 1e9 if match else math.nan
+
+
+def child_pair(steps: int, realizations: int, tilt: bool) -> dict[str, Any]:
+    """Rows 1 and 2: ``realizations`` realizations one after the other, draws included, scene not."""
     import numpy as np
 
     from slidernet.config import load_config
     from slidernet.solver import Realization, Scene
 
-    network = ({"kind": "triangular", "shape": [size, size]} if kind == "triangular"
-               else {"kind": "irregular", "n": size * size})
-    cfg = load_config({
-        "steps": steps, "record": "log", "network": {**network, "Ntilde": 1e-7},
-        "driver": {"name": "gaussian_steps", "sigma_theta": 1e-7},
-        "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
-    })
+    Realization(Scene.from_config(load_config(_pair_config(10, tilt=tilt))), np.random.SeedSequence(0)).advance()
+    scene = Scene.from_config(load_config(_pair_config(steps, realizations, tilt)))
+    if int(scene.out_steps[-1]) != steps:
+        raise RuntimeError(f"the last record is at step {scene.out_steps[-1]}, not {steps}")
+    seeds = np.random.SeedSequence(1).spawn(realizations)  # as slidernet.run with seed = 1
+    n = 0
+    mu_max = 0.0
     t0 = time.perf_counter()
-    real = Realization(Scene.from_config(cfg), np.random.SeedSequence(1))
-    t1 = time.perf_counter()
-    real.advance()
-    t2 = time.perf_counter()
-    return {"slips": real.n, "setup": t1 - t0, "kernel": t2 - t1,
-            "rate": real.n / (t2 - t1) / 1e6, "rate_with_setup": real.n / (t2 - t0) / 1e6,
-            "mean_mu": float(real.mu.mean())}
+    for ss in seeds:
+        real = Realization(scene, ss).advance()
+        n += real.n
+        mu_max += float(real.out["mu_max"][-1])
+    seconds = time.perf_counter() - t0
+    return {"slips": n, "seconds": seconds, "rate": n / seconds, "mean_mu": mu_max / realizations}
 
 
-def _run_child(kind: str, params: dict[str, Any], core: int | None) -> dict[str, float]:
-    """Run a workload in a fresh Python process; adds its peak resident memory (GB)."""
-    code = (f"import json, sys; sys.path.insert(0, {str(HERE)!r}); import bench_vs_c as b; "
-            f"print(json.dumps(b.child_{kind}(**{params!r})))")
-    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                          preexec_fn=(lambda: os.sched_setaffinity(0, {core})) if core is not None else None)
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
-    # ru_maxrss of the children is the largest so far: exact only when this child set it.
-    out["peak_GB"] = peak / 1024**2 if peak > before else float("nan")
+def child_workers(steps: int, realizations: int, workers: int) -> dict[str, Any]:
+    """Row 3: ``slidernet.run`` on 1 worker, then on ``workers``; wall and CPU seconds of each."""
+    import slidernet
+
+    slidernet.run(_pair_config(10, 2), workers=1)  # load the kernels here; forked workers inherit them
+    out: dict[str, Any] = {}
+    for w in (1, workers):
+        cfg = _pair_config(steps, realizations)
+        cfg["execution"] = {"workers": w}
+        c0, t0 = _cpu_seconds(), time.perf_counter()
+        ds = slidernet.run(cfg)
+        wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
+        n = int(ds["n"].isel(t=-1).sum())
+        out[str(w)] = {"slips": n, "seconds": wall, "rate": n / wall, "cpu_share": cpu / (wall * w)}
     return out
 
 
+def _cpu_seconds() -> float:
+    """CPU seconds of this process and of its children that have ended."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def child_lattice(size: int, steps: int, kind: str = "triangular") -> dict[str, Any]:
+    """Rows 4 and 5: one realization of a size x size lattice (or size^2 nodes); setup and kernel timed apart."""
+    import numpy as np
+
+    from slidernet.config import load_config
+    from slidernet.solver import Realization, Scene
+
+    Realization(Scene.from_config(load_config(_lattice_config(4, 2, kind))), np.random.SeedSequence(0)).advance()
+    cfg = load_config(_lattice_config(size, steps, kind))
+    rss0 = _rss_GB()
+    t0 = time.perf_counter()
+    scene = Scene.from_config(cfg)
+    t1 = time.perf_counter()
+    real = Realization(scene, np.random.SeedSequence(1))
+    t2 = time.perf_counter()
+    rss1 = _rss_GB()
+    real.advance()
+    t3 = time.perf_counter()
+    mu = real.thresholds
+    return {"slips": real.n, "scene_s": t1 - t0, "realization_s": t2 - t1, "setup": t2 - t0,
+            "kernel_s": t3 - t2, "rate": real.n / (t3 - t2), "rate_with_setup": real.n / (t3 - t0),
+            "mean_mu": float(mu.mean()), "mu_max": float(mu.max()),
+            "rss_before_setup_GB": rss0, "rss_after_setup_GB": rss1}
+
+
+CHILDREN = {"pair": child_pair, "workers": child_workers, "lattice": child_lattice}
+
+
 # ---------------------------------------------------------------------------
-# the yardsticks
+# processes
+
+
+def _spawn(cmd: list[str], core: int | None) -> tuple[str, dict[str, float]]:
+    """Run ``cmd`` (pinned to ``core`` unless None); its stdout, and its wall s, CPU s and peak RSS (GB)."""
+    # A child inherits the CPU affinity of this process: pin this one while it starts the child.
+    allowed = os.sched_getaffinity(0) if core is not None else None
+    with tempfile.TemporaryFile("w+") as err:
+        if core is not None:
+            os.sched_setaffinity(0, {core})
+        try:
+            t0 = time.perf_counter()
+            proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True)
+        finally:
+            if allowed is not None:
+                os.sched_setaffinity(0, allowed)
+        assert proc.stdout is not None
+        out = proc.stdout.read()
+        _, status, usage = os.wait4(proc.pid, 0)  # this child's own rusage, not the largest child's so far
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        proc.stdout.close()
+        if proc.returncode != 0:
+            err.seek(0)
+            raise RuntimeError(f"{' '.join(cmd)} exited with {proc.returncode}:\n{err.read()[-3000:]}")
+    # ru_maxrss is in kB on Linux
+    return out, {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_GB": usage.ru_maxrss * 1024 / 1e9}
+
+
+def run_child(name: str, params: dict[str, Any], core: int | None) -> dict[str, Any]:
+    """A slidernet workload in a fresh Python process; adds its peak RSS (GB) and CPU share."""
+    out, usage = _spawn([sys.executable, str(Path(__file__).resolve()), "--child", name, json.dumps(params)],
+                        core)
+    res = json.loads(out.strip().splitlines()[-1])
+    res["peak_GB"] = usage["peak_GB"]
+    res["cpu_share"] = usage["cpu"] / usage["wall"]
+    return res
 
 
 def build_anchors(folder: Path | None, tmp: Path) -> tuple[dict[str, Path], str]:
-    """Compile the C yardsticks; returns their paths, or {} and why not."""
+    """Compile the C yardsticks into ``tmp``; returns their paths, or {} and why they are skipped."""
     if folder is None:
-        return {}, "skipped (no anchors: --anchors or SLIDERNET_ANCHORS)"
-    cc = shutil.which("cc") or shutil.which("gcc")
+        return {}, "skipped (no anchors)"
+    sources = {name: folder / f"{name}.c" for name in ("twoslider_loop", "lattice")}
+    missing = [str(p) for p in sources.values() if not p.is_file()]
+    if missing:
+        return {}, f"skipped (no anchors: {', '.join(missing)} not found)"
+    cc = next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
     if cc is None:
         return {}, "skipped (no C compiler)"
     built = {}
-    for name in ("twoslider_loop", "lattice"):
-        src = folder / f"{name}.c"
-        if not src.exists():
-            return {}, f"skipped ({src} not found)"
-        subprocess.run([cc, "-O3", "-march=native", "-o", str(tmp / name), str(src), "-lm"], check=True)
+    for name, src in sources.items():
+        cmd = [cc, "-O3", "-march=native", "-o", str(tmp / name), str(src), "-lm"]
+        proc = subprocess.run(cmd, check=False, capture_output=True, text=True)
+        if proc.returncode != 0:
+            return {}, f"skipped (C build failed: {' '.join(cmd)}: {proc.stderr.strip()[:200]})"
         built[name] = tmp / name
     return built, ""
 
 
-def _pinned(cmd: list[str], core: int | None) -> tuple[str, float]:
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=True,
-                          preexec_fn=(lambda: os.sched_setaffinity(0, {core})) if core is not None else None)
-    return proc.stdout, time.perf_counter() - t0
-
-
-def c_pair(exe: Path, steps: int, realizations: int, core: int | None) -> dict[str, float]:
+def c_pair(exe: Path, steps: int, realizations: int, core: int | None) -> dict[str, Any]:
     p = PAIR
-    out, wall = _pinned([str(exe), str(p["mu_d"]), str(p["mean"]), str(p["std"]), str(p["Ntilde"]),
+    out, usage = _spawn([str(exe), str(p["mu_d"]), str(p["mean"]), str(p["std"]), str(p["Ntilde"]),
                          str(p["sigma_theta"]), str(steps), str(realizations), "1", "0"], core)
-    mean_n = float(out.strip().splitlines()[-1].split()[1])  # last checkpoint: q mean_n ...
-    return {"slips": mean_n * realizations, "seconds": wall, "rate": mean_n * realizations / wall / 1e6}
+    # one line per checkpoint: q mean_n mean_mu_max mean_xG^2 (unused) (unused) mean_n^2
+    q, mean_n, mean_mu_max = out.strip().splitlines()[-1].split()[:3]
+    if int(q) != steps:
+        raise RuntimeError(f"unexpected last line of twoslider_loop: {out.strip().splitlines()[-1]!r}")
+    slips = round(float(mean_n) * realizations)
+    return {"slips": slips, "seconds": usage["wall"], "rate": slips / usage["wall"],
+            "mean_mu": float(mean_mu_max), "peak_GB": usage["peak_GB"], "cpu_share": usage["cpu"] / usage["wall"]}
 
 
-def c_lattice(exe: Path, size: int, steps: int, core: int | None) -> dict[str, float]:
-    out, _ = _pinned([str(exe), str(size), str(size), "1e-7", "1e-7", str(steps), "1"], core)
-    num = r"([0-9.e+-]+)"
+def c_lattice(exe: Path, size: int, steps: int, core: int | None) -> dict[str, Any]:
+    out, usage = _spawn([str(exe), str(size), str(size), str(LATTICE["Ntilde"]), str(LATTICE["sigma_theta"]),
+                         str(steps), "1"], core)
+    num = r"([0-9.eE+-]+|nan|inf)"
     m = re.search(rf"slips {num} setup {num} s total {num} s rate {num} slips/s \(run only {num}\) "
-                  rf"mean_mu {num}", out)
+                  rf"mean_mu {num} mu_max {num}", out)
     if m is None:
         raise RuntimeError(f"unexpected output of the lattice yardstick: {out!r}")
-    slips, setup, _total, rate, run_only, mean_mu = (float(x) for x in m.groups())
-    return {"slips": slips, "setup": setup, "rate_with_setup": rate / 1e6, "rate": run_only / 1e6,
-            "mean_mu": mean_mu}
+    slips, setup, total, _rate, _run_only, mean_mu, mu_max = (float(x) for x in m.groups())
+    # Rates from the seconds it prints (3 decimals), not from its 3-digit rates.
+    return {"slips": int(slips), "setup": setup, "kernel_s": total - setup, "rate": slips / (total - setup),
+            "rate_with_setup": slips / total, "mean_mu": mean_mu, "mu_max": mu_max,
+            "peak_GB": usage["peak_GB"], "cpu_share": usage["cpu"] / usage["wall"]}
+
+
+# ---------------------------------------------------------------------------
+# the table
+
+
+def _fmt(x: Any, unit: str) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    if unit == "M/s":
+        return f"{x / 1e6:.2f} M/s"
+    if unit == "s":
+        return f"{x:.2f} s"
+    if unit == "GB":
+        return f"{x:.2f} GB"
+    if unit == "x":
+        return f"{x:.2f} x"
+    return f"{x:.3g}"
+
+
+def _pair_str(a: Any, b: Any, fmt: str) -> str:
+    if a is None:
+        return ""
+    return format(a, fmt) + " / " + (format(b, fmt) if b is not None else "-")
+
+
+class Table:
+    COLUMNS = ("workload", "slidernet", "C", "slidernet / C", "target", "slips: slidernet / C",
+               "mean mu: slidernet / C")
+
+    def __init__(self, why_no_c: str) -> None:
+        self.why = why_no_c
+        self.rows: list[dict[str, Any]] = []
+
+    def add(self, workload: str, unit: str, ours: float, theirs: float | None = None, *, target: str = "",
+            ratio: float | str | None = None, c_applies: bool = True, slips: tuple[Any, Any] = (None, None),
+            mu: tuple[Any, Any] = (None, None), ours_text: str | None = None) -> None:
+        """One row; the ratio is ours / theirs unless given; ``c_applies`` False: no C counterpart."""
+        if ratio is None and c_applies:
+            ratio = ours / theirs if theirs is not None else self.why
+        elif ratio is None:
+            ratio = "no C counterpart"
+        row = {"workload": workload, "unit": unit, "slidernet": ours, "C": theirs, "ratio": ratio,
+               "target": target, "slips_slidernet": slips[0], "slips_C": slips[1], "mean_mu_slidernet": mu[0],
+               "mean_mu_C": mu[1], "_ours_text": ours_text}
+        self.rows.append(row)
+        print(f"  {workload}: " + " | ".join(self._cells(row)[1:]), flush=True)
+
+    def _cells(self, r: dict[str, Any]) -> list[str]:
+        ratio = r["ratio"]
+        ratio = f"{ratio:.2f}" if isinstance(ratio, float) else ratio
+        c = _fmt(r["C"], r["unit"]) if r["C"] is not None else "-"
+        return [r["workload"], r["_ours_text"] or _fmt(r["slidernet"], r["unit"]), c, ratio, r["target"],
+                _pair_str(r["slips_slidernet"], r["slips_C"], ".4g"), _pair_str(r["mean_mu_slidernet"],
+                                                                               r["mean_mu_C"], ".5f")]
+
+    def markdown(self) -> str:
+        lines = ["| " + " | ".join(self.COLUMNS) + " |", "|" + "---|" * len(self.COLUMNS)]
+        lines += ["| " + " | ".join(self._cells(r)) + " |" for r in self.rows]
+        return "\n".join(lines)
+
+    def write_csv(self, path: Path) -> None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fields = [k for k in self.rows[0] if not k.startswith("_")]
+        with path.open("w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+            w.writeheader()
+            w.writerows(self.rows)
 
 
 # ---------------------------------------------------------------------------
 
 
+def _pick_core(core: int) -> int | None:
+    if not hasattr(os, "sched_setaffinity"):
+        print("no os.sched_setaffinity here: the runs are not pinned to one core")
+        return None
+    allowed = sorted(os.sched_getaffinity(0))
+    if core in allowed:
+        return core
+    print(f"core {core} is not available to this process (allowed: {allowed}); using core {allowed[-1]}")
+    return allowed[-1]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--anchors", type=Path, default=os.environ.get("SLIDERNET_ANCHORS"))
-    ap.add_argument("--quick", action="store_true", help="short runs: a smoke test, noisy ratios")
-    ap.add_argument("--paper", action="store_true", help="also time `slidernet paper` (full, 2 cores)")
-    ap.add_argument("--core", type=int, default=1, help="the core of the one-core runs")
-    ap.add_argument("--csv", type=Path, default=None)
+    ap.add_argument("--anchors", type=Path, default=os.environ.get("SLIDERNET_ANCHORS") or None,
+                    help="folder with twoslider_loop.c and lattice.c (default: $SLIDERNET_ANCHORS)")
+    ap.add_argument("--quick", action="store_true", help="short runs, a smoke test: noisy ratios")
+    ap.add_argument("--sizes", type=int, nargs="+", default=None,
+                    help="L of the large L x L lattices (default 1000; --quick: 100)")
+    ap.add_argument("--core", type=int, default=1, help="the core of the one-core runs (default 1)")
+    ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
+    ap.add_argument("--no-delaunay", action="store_true",
+                    help="leave out the irregular (Delaunay) network as large as the largest lattice")
+    ap.add_argument("--paper", action="store_true",
+                    help="also time `slidernet paper` (full preset, all cores; minutes)")
+    ap.add_argument("--child", nargs=2, metavar=("NAME", "JSON"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    core = args.core if hasattr(os, "sched_setaffinity") and args.core in os.sched_getaffinity(0) else None
-    q = args.quick
-    pair_steps, big, big_steps = (10_000, 100, 20) if q else (100_000, 1000, 20)
-    rows: list[dict[str, Any]] = []
+    if args.child:
+        name, params = args.child
+        print(json.dumps(CHILDREN[name](**json.loads(params))), flush=True)
+        return 0
 
-    def row(workload: str, ours: str, c: str, ratio: str, target: str, note: str = "") -> None:
-        rows.append({"workload": workload, "slidernet": ours, "C": c, "ratio": ratio, "target": target,
-                     "note": note})
-        print(f"{workload}: slidernet {ours} | C {c} | ratio {ratio} (target {target}) {note}", flush=True)
+    q = args.quick
+    pair_steps, small_steps, big_steps = (10_000, 200, 20) if q else (100_000, 2000, 20)
+    sizes = sorted(args.sizes or ([100] if q else [1000]))
+    realizations, ens_realizations = 10, 20
+    core = _pick_core(args.core)
+    t_start = time.perf_counter()
+    print(f"slidernet vs C, one core = core {core}; load average {os.getloadavg()[0]:.2f}", flush=True)
 
     with tempfile.TemporaryDirectory(prefix="slidernet-vs-c-") as tmp:
         exe, why = build_anchors(args.anchors, Path(tmp))
-        if why:
+        if why == "skipped (no anchors)":
+            print("C yardsticks: skipped (no anchors): pass --anchors DIR or set SLIDERNET_ANCHORS", flush=True)
+        elif why:
             print(f"C yardsticks: {why}", flush=True)
+        table = Table(why)
+        shares: list[float] = []
 
-        def ratio(ours: float, theirs: dict[str, float] | None, key: str = "rate") -> str:
-            return f"{ours / theirs[key]:.2f}" if theirs else why
+        # 1. two sliders, one core
+        ours = run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": False}, core)
+        theirs = c_pair(exe["twoslider_loop"], pair_steps, realizations, core) if exe else None
+        shares += [ours["cpu_share"]] + ([theirs["cpu_share"]] if theirs else [])
+        table.add(f"two sliders, {realizations} x {pair_steps:,} steps, one core", "M/s", ours["rate"],
+                  theirs and theirs["rate"], target=">= 1.2", slips=(ours["slips"], theirs and theirs["slips"]),
+                  mu=(ours["mean_mu"], theirs and theirs["mean_mu"]))
 
-        # 1-3: two sliders
-        one = _run_child("pair", {"steps": pair_steps, "realizations": 10, "mu_eff": False, "workers": 1}, core)
-        c1 = c_pair(exe["twoslider_loop"], pair_steps, 10, core) if exe else None
-        row("two sliders, one core, draws included", f"{one['rate']:.1f} M/s",
-            f"{c1['rate']:.1f} M/s" if c1 else "-", ratio(one["rate"], c1), ">= 1.2")
-        tilt = _run_child("pair", {"steps": pair_steps // 10, "realizations": 10, "mu_eff": True, "workers": 1},
-                          core)
-        row("two sliders with the tilt test (mu_eff)", f"{tilt['rate']:.1f} M/s", "-", "-", ">= 20 M/s")
-        two = _run_child("pair", {"steps": pair_steps, "realizations": 20, "mu_eff": False, "workers": 2}, None)
-        row("two sliders, 2 cores / 1 core", f"{two['rate']:.1f} M/s", "-", f"{two['rate'] / one['rate']:.2f}",
-            ">= 1.9")
+        # 2. with the tilt test
+        tilt = run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": True}, core)
+        shares.append(tilt["cpu_share"])
+        table.add("two sliders + tilt test (mu_eff), one core", "M/s", tilt["rate"], c_applies=False,
+                  target=">= 20 M/s", slips=(tilt["slips"], None),
+                  mu=(tilt["mean_mu"], None))
 
-        # 4-7: lattices
-        small = _run_child("network", {"kind": "triangular", "size": 32, "steps": 200 if q else 2000}, core)
-        cs = c_lattice(exe["lattice"], 32, 200 if q else 2000, core) if exe else None
-        row("triangular 32 x 32, kernel", f"{small['rate']:.2f} M/s", f"{cs['rate']:.2f} M/s" if cs else "-",
-            ratio(small["rate"], cs), ">= 1.2",
-            f"{small['slips']:.3g} slips" + (f" (C {cs['slips']:.3g})" if cs else ""))
-        large = _run_child("network", {"kind": "triangular", "size": big, "steps": big_steps}, core)
-        cl = c_lattice(exe["lattice"], big, big_steps, core) if exe else None
-        label = f"triangular {big} x {big}"
-        row(f"{label}, setup included", f"{large['rate_with_setup']:.2f} M/s",
-            f"{cl['rate_with_setup']:.2f} M/s" if cl else "-",
-            ratio(large["rate_with_setup"], cl, "rate_with_setup"),
-            ">= 1.0", f"{large['slips']:.3g} slips" + (f" (C {cl['slips']:.3g})" if cl else ""))
-        row(f"{label}, kernel alone", f"{large['rate']:.2f} M/s", f"{cl['rate']:.2f} M/s" if cl else "-",
-            ratio(large["rate"], cl), ">= 1.2")
-        row(f"{label}, setup", f"{large['setup']:.2f} s", f"{cl['setup']:.2f} s" if cl else "-", "-", "<= 0.5 s")
-        row(f"{label}, peak resident memory", f"{large['peak_GB']:.2f} GB", "-", "-", "<= 0.6 GB")
-        row(f"kernel rate at {big * big:.0e} nodes / at 1e3", f"{large['rate'] / small['rate']:.2f}", "-", "-",
-            ">= 0.5")
-        # Every node of an irregular network is driven: a step makes about 20 N slips (a lattice's, about
-        # 0.2 N at the boundary), so 2 steps are plenty of work.
-        irr = _run_child("network", {"kind": "irregular", "size": big, "steps": 2}, core)
-        row(f"irregular (Delaunay) {big * big:.0e} nodes, kernel", f"{irr['rate']:.2f} M/s", "-",
-            f"{large['rate'] / irr['rate']:.2f} x slower than triangular", "<= 1.5 x",
-            f"{irr['slips']:.3g} slips in 2 steps, setup {irr['setup']:.2f} s, peak {irr['peak_GB']:.2f} GB")
+        # 3. 2 workers against 1 (slidernet.run, execution.workers)
+        ens = run_child("workers", {"steps": pair_steps, "realizations": ens_realizations, "workers": 2}, None)
+        one, two = ens["1"], ens["2"]
+        if one["slips"] != two["slips"]:
+            raise AssertionError(f"slidernet.run: {one['slips']} slips on 1 worker, {two['slips']} on 2")
+        table.add(f"two sliders, {ens_realizations} x {pair_steps:,} steps, slidernet.run on 2 workers / 1",
+                  "x", two["rate"] / one["rate"], ratio="no C counterpart", target=">= 1.9",
+                  ours_text=f"{two['rate'] / one['rate']:.2f} x ({two['rate'] / 1e6:.1f} / "
+                            f"{one['rate'] / 1e6:.1f} M/s; CPU share {two['cpu_share']:.2f} / "
+                            f"{one['cpu_share']:.2f})", slips=(two["slips"], None))
+
+        # 4. the small lattice
+        small = run_child("lattice", {"size": SMALL, "steps": small_steps}, core)
+        c_small = c_lattice(exe["lattice"], SMALL, small_steps, core) if exe else None
+        shares += [small["cpu_share"]] + ([c_small["cpu_share"]] if c_small else [])
+        table.add(f"triangular {SMALL} x {SMALL}, {small_steps} steps, kernel alone", "M/s", small["rate"],
+                  c_small and c_small["rate"], target=">= 1.2",
+                  slips=(small["slips"], c_small and c_small["slips"]),
+                  mu=(small["mean_mu"], c_small and c_small["mean_mu"]))
+
+        # 5. the large lattices
+        large: dict[int, tuple[dict[str, Any], dict[str, Any] | None]] = {}
+        for L in sizes:
+            big = run_child("lattice", {"size": L, "steps": big_steps}, core)
+            c_big = c_lattice(exe["lattice"], L, big_steps, core) if exe else None
+            shares += [big["cpu_share"]] + ([c_big["cpu_share"]] if c_big else [])
+            large[L] = (big, c_big)
+            label = f"triangular {L} x {L}, {big_steps} steps"
+            check = {"slips": (big["slips"], c_big and c_big["slips"]),
+                     "mu": (big["mean_mu"], c_big and c_big["mean_mu"])}
+            table.add(f"{label}, setup included", "M/s", big["rate_with_setup"],
+                      c_big and c_big["rate_with_setup"], target=">= 1.0" if L == 1000 else "", **check)
+            table.add(f"{label}, kernel alone", "M/s", big["rate"], c_big and c_big["rate"],
+                      target=">= 1.2" if L == 1000 else "")
+            table.add(f"{label}, setup", "s", big["setup"], c_big and c_big["setup"],
+                      target="<= 0.5 s" if L == 1000 else "",
+                      ours_text=f"{big['setup']:.2f} s (scene {big['scene_s']:.2f} + realization "
+                                f"{big['realization_s']:.2f})")
+            table.add(f"{label}, peak resident memory", "GB", big["peak_GB"], c_big and c_big["peak_GB"],
+                      target="<= 0.6 GB" if L == 1000 else "",
+                      ours_text=f"{big['peak_GB']:.2f} GB ({big['rss_before_setup_GB']:.2f} before setup)")
+
+        # 6. largest lattice against the small one
+        L = sizes[-1]
+        big, c_big = large[L]
+        for key, what in (("rate", "kernel alone"), ("rate_with_setup", "setup included")):
+            ours_r = big[key] / small[key]
+            theirs_r = c_big[key] / c_small[key] if c_big and c_small else None
+            table.add(f"rate at {L} x {L} / at {SMALL} x {SMALL}, {what}", "x", ours_r, theirs_r,
+                      target=">= 0.5" if key == "rate" and L == 1000 else "")
+
+        # 7. an irregular network of the largest size (every node driven: ~20 N slips a step)
+        if not args.no_delaunay:
+            irr = run_child("lattice", {"size": L, "steps": 2, "kind": "irregular"}, core)
+            shares.append(irr["cpu_share"])
+            table.add(f"irregular (Delaunay) {L * L:,} nodes, 2 steps, kernel alone", "M/s", irr["rate"],
+                      ratio="no C counterpart", target="<= 1.5 x" if L == 1000 else "",
+                      ours_text=f"{irr['rate'] / 1e6:.2f} M/s ({big['rate'] / irr['rate']:.2f} x slower than "
+                                f"triangular; setup {irr['setup']:.2f} s, peak {irr['peak_GB']:.2f} GB)",
+                      slips=(irr["slips"], None), mu=(irr["mean_mu"], None))
 
     if args.paper:
         out = Path(tempfile.mkdtemp(prefix="slidernet-paper-"))
-        before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-        t0 = time.perf_counter()
-        subprocess.run(["slidernet", "paper", "--out", str(out), "--no-progress"], check=True,
-                       capture_output=True)
-        wall = time.perf_counter() - t0
-        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-        shutil.rmtree(out, ignore_errors=True)
-        row("slidernet paper, full preset, 2 cores", f"{wall:.0f} s",
-            "-", "-", "<= 90 s, <= 1.2 GB",
-            f"peak {peak / 1024**2:.2f} GB (largest process)" if peak > before else "")
+        try:
+            _, usage = _spawn([sys.executable, "-m", "slidernet.cli", "paper", "--out", str(out), "--no-progress"],
+                              None)
+        finally:
+            shutil.rmtree(out, ignore_errors=True)
+        table.add("slidernet paper, full preset, all cores", "s", usage["wall"], ratio="no C counterpart",
+                  target="<= 90 s, <= 1.2 GB",
+                  ours_text=f"{usage['wall']:.0f} s, peak {usage['peak_GB']:.2f} GB (largest process)")
 
-    print("\n| workload | slidernet | C yardstick | ratio | target | note |\n|---|---|---|---|---|---|")
-    for r in rows:
-        print(f"| {r['workload']} | {r['slidernet']} | {r['C']} | {r['ratio']} | {r['target']} | {r['note']} |")
-    if args.csv:
-        with args.csv.open("w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+    wall = time.perf_counter() - t_start
+    print()
+    print(table.markdown())
+    print()
+    low = " (below 0.95: another process took the core, the rates are low for that reason)" \
+        if min(shares) < 0.95 else ""
+    print(f"wall time {wall:.0f} s; load average {os.getloadavg()[0]:.2f}; CPU share of the pinned runs "
+          f"{min(shares):.2f} - {max(shares):.2f}{low}")
+    if args.csv is not None:
+        table.write_csv(args.csv)
     return 0
 
 
