@@ -5,9 +5,10 @@ numpy runs, so drawing one value at a time here gives the same bits, from
 the same Generator (whose state advances in place), as the plugin's batched
 ``sample`` followed by the truncation of
 :class:`~slidernet.plugins.distributions.TruncatedStream`: the accepted
-values are the same sequence. The cost is what differs: about 4 ns a draw
-against about 15 ns through numpy's batched call, the filter and the
-concatenation (``benchmarks/bench_draws.py``).
+values are the same sequence. The cost is what differs: for the Gaussian,
+4.3 ns a draw against 15.1 ns through numpy's batched call, the filter and
+the concatenation (``python benchmarks/bench_draws.py``, one core,
+2026-11-24; the other laws gain less).
 
 Only the laws whose single draws are numpy's batched draws to the bit are
 here (``tests/test_draws.py`` checks each): Gaussian, uniform, Weibull and

@@ -275,18 +275,17 @@ def buffers_low(st, draws, catalogue):
 
 
 @kernel_jit(inline="always")
-def next_driving_event(st, heaps, thetas):
+def next_driving_event(st, heaps, thetas, s):
     """The next node to reach its threshold as theta moves linearly from thetas[q] to thetas[q + 1].
 
-    Reads the two driving heaps (upper critical thetas when theta rises,
-    lower ones when it falls; eq. `critique` for each node). Returns
-    ``(node, theta_c, s)``: node -1 if none is reached within the segment
-    (inclusive at its end); theta_c is clamped to the current theta where
-    rounding put it behind; s is the sign of d(theta)/dt.
+    ``s`` is the sign of d(theta)/dt in the step (:func:`theta_direction`).
+    Reads the driving heap of that direction (upper critical thetas when
+    theta rises, lower ones when it falls; eq. `critique` for each node).
+    Returns ``(node, theta_c)``: node -1 if none is reached within the
+    segment (inclusive at its end); theta_c is clamped to the current theta
+    where rounding put it behind.
     """
-    q = st.q
-    theta_b = thetas[q + 1]
-    s = 1.0 if theta_b > thetas[q] else (-1.0 if theta_b < thetas[q] else 0.0)
+    theta_b = thetas[st.q + 1]
     best = -1
     thc = 0.0
     if s > 0.0 and heaps.size[UP] > 0:
@@ -301,7 +300,15 @@ def next_driving_event(st, heaps, thetas):
             thc = theta  # rounding: the node is already at its threshold
         if s * (theta_b - thc) < 0.0:
             best = -1
-    return best, thc, s
+    return best, thc
+
+
+@kernel_jit(inline="always")
+def theta_direction(st, thetas):
+    """The sign s of d(theta)/dt in step q: 1.0, -1.0, or 0.0 where theta stands still."""
+    theta_a = thetas[st.q]
+    theta_b = thetas[st.q + 1]
+    return 1.0 if theta_b > theta_a else (-1.0 if theta_b < theta_a else 0.0)
 
 
 @kernel_jit(inline="always")

@@ -38,6 +38,7 @@ from slidernet.kernels.heap import (
     open_driving_event,
     open_initial_relaxation,
     redraw_threshold,
+    theta_direction,
     write_output,
 )
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, UNSTABLE, UP, kernel_jit
@@ -73,19 +74,17 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
 
 
 @kernel_jit(inline="always")
-def turn(st, net, nodes, heaps, thetas, critical_roots):
-    """Make the driving heap of theta's direction in step q the active one, up to date.
+def turn(net, nodes, heaps, s, critical_roots):
+    """Make the driving heap of theta's direction s the active one, up to date.
 
     When theta turns, the nodes re-keyed since the last turn get their key in
     the heap that becomes active (their key in the other one is up to date:
     it was the active heap). O(stale nodes log N), once per turn, instead of
     a second sift at every update.
     """
-    q = st.q
-    rising = thetas[q + 1] > thetas[q]
-    if not rising and not thetas[q + 1] < thetas[q]:
+    if s == 0.0:
         return  # theta stands still: no driving event in this step
-    want = UP if rising else DOWN
+    want = UP if s > 0.0 else DOWN
     if heaps.active[0] == want:
         return
     heaps.active[0] = want
@@ -177,8 +176,9 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             return RECOMPUTE
         if st.q >= steps:
             return DONE
-        turn(st, net, nodes, heaps, thetas, critical_roots)
-        best, thc, s = next_driving_event(st, heaps, thetas)
+        s = theta_direction(st, thetas)
+        turn(net, nodes, heaps, s, critical_roots)
+        best, thc = next_driving_event(st, heaps, thetas, s)
         if best >= 0:
             st.theta = thc
             status = buffers_low(st, draws, catalogue)

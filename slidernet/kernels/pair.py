@@ -25,16 +25,6 @@ def _most_overloaded(F, mu0, mu1):
     return -1, 0.0
 
 
-@kernel_jit(inline="always")
-def _first_critical(s, u, mu0, mu1):
-    """Eq. `critique` for each slider as theta moves with sign s: (i, theta_c) of the first one reached."""
-    th0 = s * mu0 * 1.0 + u
-    th1 = s * mu1 * 1.0 + u
-    if s * th1 < s * th0:
-        return 1, th1
-    return 0, th0
-
-
 @kernel_jit()
 def run_pair(thetas, out_steps, mu, state, draws, out, settings):
     """Advance the two-slider system through ``thetas`` (units of Ntilde).
@@ -105,15 +95,15 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
             theta_b = thetas[q + 1]
             theta_a = thetas[q]
             s = 1.0 if theta_b > theta_a else (-1.0 if theta_b < theta_a else 0.0)
-            if s != 0.0 and not do_tilt:
-                # The common case as a tight loop: the driving events of this step, one slip
-                # each, until the step ends, the buffer runs out or a slip leaves a slider
-                # unstable (then the general loop below takes over). It runs in coordinates
-                # multiplied by s = +-1 (v = s u, vt = s theta, xr = s x_G), where eq.
-                # `critique` reads s theta_c = mu_s,i + v and a slip adds 2 (mu_s,i - mu_d) to
-                # v whichever slider slips: negation is exact and commutes with rounding, so
-                # these are the general path's bits, with no multiplication by s on u's chain
-                # of dependent operations. Which slider slips is a coin toss: a select, not a
+            if s != 0.0:
+                # The driving events of this step, one slip each, until the step ends, a
+                # buffer runs out or a slip leaves a slider unstable (the avalanche branch
+                # above takes over). The loop runs in coordinates multiplied by s = +-1
+                # (v = s u, vt = s theta, xr = s x_G), where eq. `critique` reads
+                # s theta_c = mu_s,i + v and a slip adds 2 (mu_s,i - mu_d) to v whichever
+                # slider slips: negation is exact and commutes with rounding, so these are
+                # the bits of the unscaled equations, with nothing but an add on u's chain of
+                # dependent operations. Which slider slips is a coin toss: a select, not a
                 # branch.
                 v = s * u
                 vt = s * theta
@@ -121,7 +111,7 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 xr = s * xg
                 d0 = 2.0 * (mu0 * 1.0 - mu_d * 1.0)
                 d1 = 2.0 * (mu1 * 1.0 - mu_d * 1.0)
-                while p < nbuf:
+                while True:
                     t0 = mu0 * 1.0 + v
                     t1 = mu1 * 1.0 + v
                     one = t1 < t0
@@ -129,8 +119,16 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                     if tc < vt:
                         tc = vt  # rounding: the slider is already at its threshold
                     if vb < tc:
-                        break
+                        break  # no slider reaches its threshold before theta_b
                     vt = tc
+                    if p >= nbuf:
+                        status = NEED_MU
+                        break
+                    if do_tilt:
+                        # F = theta_c - u, exactly s (tc - v).
+                        status = tilt_sample(st, draws, out, k, s * (tc - v), mu0, mu1, mu_d)
+                        if status != DONE:
+                            break
                     d = d1 if one else d0
                     v = v + d
                     xr += (d if one else -d) * 0.5
@@ -153,41 +151,22 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 u = s * v
                 theta = s * vt
                 xg = s * xr
-                if pending:
-                    continue
-            i = -1
-            thc = theta
-            if s != 0.0:
-                i, thc = _first_critical(s, u, mu0, mu1)
-                if s * (thc - theta) < 0.0:
-                    thc = theta  # rounding: the slider is already at its threshold
-                if s * (theta_b - thc) < 0.0:
-                    i = -1
-            if i < 0:
-                q += 1
-                theta = theta_b
-                if k < out_steps.size and out_steps[k] == q:
-                    st.n_slips = n
-                    st.mu_max = mumax
-                    st.x_G = xg
-                    st.n_records = nrec
-                    st.next_out = k
-                    write_output(st, mu, out)
-                    k += 1
-                continue
-            theta = thc
-            if p >= nbuf:
-                status = NEED_MU
-                break
-            if do_tilt:
-                status = tilt_sample(st, draws, out, k, thc - u, mu0, mu1, mu_d)
                 if status != DONE:
                     break
-            # At theta_c the force on slider i is exactly s_i mu_s,i.
-            aFi = (mu1 if i == 1 else mu0) * 1.0
-            Fi = s * aFi if i == 1 else -s * aFi
-            av = 0
-            nev += 1
+                if pending:
+                    continue
+            # The step ends.
+            q += 1
+            theta = theta_b
+            if k < out_steps.size and out_steps[k] == q:
+                st.n_slips = n
+                st.mu_max = mumax
+                st.x_G = xg
+                st.n_records = nrec
+                st.next_out = k
+                write_output(st, mu, out)
+                k += 1
+            continue
         # Slider i slips alone (eq. `displacement`); its threshold is redrawn.
         sgn = 1.0 if Fi > 0.0 else -1.0
         du = 2.0 * (aFi - mu_d * 1.0) * sgn / 1.0

@@ -228,10 +228,23 @@ def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
 def slip_displacement(net, nodes, settings, i, theta, driving, s):
     """The slip of node i alone, the others fixed: (ok, du_x, du_y).
 
-    ``settings.slip_mode`` picks the straight line or the exact 2D motion;
-    ok is False if the exact motion did not come to rest within its step
-    budget. A driving slip (``driving``) starts exactly at the threshold,
+    A driving slip (``driving``) starts exactly at the threshold,
     |F_i| = mu_s,i N_i, along the force computed at theta.
+    """
+    Fx = nodes.a[i, 0] + net.g[i, 0] * theta
+    Fy = nodes.a[i, 1] + net.g[i, 1] * theta
+    absF = nodes.mu[i] * net.normal_load[i] if driving else math.sqrt(Fx * Fx + Fy * Fy)
+    return slip_under(net, settings, i, Fx, Fy, absF, absF)
+
+
+@kernel_jit(inline="always")
+def slip_under(net, settings, i, Fx, Fy, norm, mag):
+    """(ok, du_x, du_y): node i slides from rest under the force (Fx, Fy), the others fixed.
+
+    ``settings.slip_mode`` picks the straight line (:func:`straight_slip`,
+    with ``norm`` and ``mag``) or the exact 2D motion (:func:`exact_slip`);
+    ok is False if the exact motion did not come to rest within its step
+    budget. Used by the kernel and by the network tilt test.
     """
     fd = settings.mu_d * net.normal_load[i]
     d = net.diag[i]  # the diagonal block K_ii
@@ -239,13 +252,10 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
     kxx = K[d, 0, 0]
     kxy = K[d, 0, 1]
     kyy = K[d, 1, 1]
-    Fx = nodes.a[i, 0] + net.g[i, 0] * theta
-    Fy = nodes.a[i, 1] + net.g[i, 1] * theta
     if settings.slip_mode == SLIP_EXACT:
         dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
         return nsteps >= 0, dux, duy
-    absF = nodes.mu[i] * net.normal_load[i] if driving else math.sqrt(Fx * Fx + Fy * Fy)
-    dux, duy = straight_slip(Fx, Fy, absF, absF, kxx, kxy, kyy, fd)
+    dux, duy = straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd)
     return True, dux, duy
 
 

@@ -54,7 +54,7 @@ from __future__ import annotations
 import math
 
 from slidernet.kernels.heap import heap_clear, heap_set
-from slidernet.kernels.plane import SLIP_EXACT, exact_slip, spread, straight_slip
+from slidernet.kernels.plane import slip_under, spread
 from slidernet.kernels.state import kernel_jit
 
 # Return codes (negative: no sample).
@@ -104,17 +104,8 @@ def _displacement(net, settings, i, f, driving, G, mu):
     n = net.normal_load[i]
     Tx = G[i, 0] + f * n
     Ty = G[i, 1]
-    fd = settings.mu_d * n
-    d = net.diag[i]
-    kxx = net.K_blocks[d, 0, 0]
-    kxy = net.K_blocks[d, 0, 1]
-    kyy = net.K_blocks[d, 1, 1]
-    if settings.slip_mode == SLIP_EXACT:
-        dux, duy, nsteps = exact_slip(Tx, Ty, kxx, kxy, kyy, fd)
-        return nsteps >= 0, dux, duy
     norm = math.sqrt(Tx * Tx + Ty * Ty)
-    dux, duy = straight_slip(Tx, Ty, norm, mu[i] * n if driving else norm, kxx, kxy, kyy, fd)
-    return True, dux, duy
+    return slip_under(net, settings, i, Tx, Ty, norm, mu[i] * n if driving else norm)
 
 
 @kernel_jit(inline="always")
