@@ -104,7 +104,10 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 # slider slips: negation is exact and commutes with rounding, so these are
                 # the bits of the unscaled equations, with nothing but an add on u's chain of
                 # dependent operations. Which slider slips is a coin toss: a select, not a
-                # branch.
+                # branch, on mu_s,2 < mu_s,1, which does not wait for v (comparing the
+                # rounded theta_c put two more operations on the chain: 75 -> 108 M/s, draws
+                # included, benchmarks/ab_versions.py). Where the rounded theta_c tie, slider 1
+                # slips, as before and as in the heaps: that check is a branch never taken.
                 v = s * u
                 vt = s * theta
                 vb = s * theta_b
@@ -112,10 +115,10 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 d0 = 2.0 * (mu0 * 1.0 - mu_d * 1.0)
                 d1 = 2.0 * (mu1 * 1.0 - mu_d * 1.0)
                 while True:
-                    t0 = mu0 * 1.0 + v
-                    t1 = mu1 * 1.0 + v
-                    one = t1 < t0
-                    tc = t1 if one else t0
+                    one = mu1 < mu0
+                    tc = (mu1 if one else mu0) * 1.0 + v
+                    if one and mu0 * 1.0 + v == tc:
+                        one = False  # tie of the rounded theta_c: the lowest index, as in the heaps
                     if tc < vt:
                         tc = vt  # rounding: the slider is already at its threshold
                     if vb < tc:
