@@ -123,6 +123,17 @@ def test_block_assembly_equals_the_sparse_product(kind):
     np.testing.assert_allclose(direct, product, rtol=0, atol=1e-13)
 
 
+@pytest.mark.parametrize("kind", list(NETWORKS), ids=list(NETWORKS))
+def test_the_kernels_diagonal_blocks_are_K_ii(kind):
+    scene = Scene.from_config(load_config(network_config(kind, **NETWORKS[kind])))
+    net = scene.operators  # all three are 2D: a Plane
+    d = scene.network.dim
+    dense = scene.K.toarray()
+    for n in range(scene.network.n_nodes):
+        np.testing.assert_array_equal(net.K_blocks[net.diag[n]], dense[n * d:(n + 1) * d, n * d:(n + 1) * d])
+        assert net.indices[net.diag[n]] == n
+
+
 @pytest.mark.slow
 def test_incremental_forces_do_not_drift_over_1e8_slips():
     # 1e8 slips (about 70 s) on a 4 x 4 triangular lattice driven hard

@@ -10,6 +10,7 @@ import numpy as np
 from slidernet.config import Config, build_network, choose_kernel
 from slidernet.errors import ConfigError
 from slidernet.kernels import Chain, Plane, Settings
+from slidernet.kernels.assembly import diagonal_positions
 from slidernet.model.network import Network
 
 
@@ -74,10 +75,8 @@ def _plane(indptr: np.ndarray, indices: np.ndarray, blocks: np.ndarray, g: np.nd
     """The 2D operators from the block-CSR rows of K: ``blocks`` (nnzb, 2, 2) of the rows ``indptr``."""
     indptr = indptr.astype(np.int64)
     indices = indices.astype(np.int64)
-    row = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
-    return Plane(indptr=indptr, indices=indices, K_blocks=blocks,
-                 diag=np.flatnonzero(indices == row).astype(np.int64), g=g, normal_load=normal_load, w=w,
-                 unit_load=unit_load)
+    return Plane(indptr=indptr, indices=indices, K_blocks=blocks, diag=diagonal_positions(indptr, indices), g=g,
+                 normal_load=normal_load, w=w, unit_load=unit_load)
 
 
 class TiltOperators(NamedTuple):
