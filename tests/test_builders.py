@@ -302,8 +302,10 @@ def test_irregular_leaves_the_global_rng_alone():
     np.testing.assert_array_equal(np.random.get_state()[1], before)  # noqa: NPY002
 
 
-def test_irregular_geometry_and_delaunay_edges():
-    n = 300
+# The builder hands the points to Qhull in strips (for speed); the springs must be those of the
+# triangulation of the points in draw order.
+@pytest.mark.parametrize("n", [300, 5000], ids=["n300", "n5000"])
+def test_irregular_geometry_and_delaunay_edges(n):
     net = irregular(n, NT, np.random.default_rng(2))
     pos = net.positions
     assert pos.shape == (n, 2)

@@ -298,11 +298,18 @@ def irregular(n: int, Ntilde: float, rng: np.random.Generator, **overrides: Any)
         raise param_error("rng", "irregular", "a numpy.random.Generator", type(rng).__name__)
     n = int(n)
     positions = rng.uniform(0.0, math.sqrt(n), size=(n, 2))
+    # Qhull inserts the points in the order it gets them; in draw order each one lands far
+    # from the last. Handed over along strips of width 1 l0 (alternately left to right and
+    # right to left) they come next to each other: 10.0 -> 7.3 s at a million points. The
+    # triangulation of points in general position does not depend on the order, so the
+    # springs are the same; the nodes keep their draw order.
+    strip = np.floor(positions[:, 1]).astype(np.int64)
+    order = np.lexsort((np.where(strip % 2 == 0, positions[:, 0], -positions[:, 0]), strip))
     try:
-        tri = scipy.spatial.Delaunay(positions)
+        tri = scipy.spatial.Delaunay(positions[order])
     except scipy.spatial.QhullError as err:  # only for degenerate (e.g. collinear) draws
         raise ConfigError(f"The Delaunay triangulation of the {n} random points failed: {err}") from err
-    s = tri.simplices.astype(np.int64)
+    s = order[tri.simplices]
     pairs = np.concatenate([s[:, [0, 1]], s[:, [1, 2]], s[:, [0, 2]]])
     pairs.sort(axis=1)
     # Sorting the 1D key i * n + j orders the springs lexicographically by (i, j);
