@@ -152,7 +152,8 @@ def base_config(network: dict[str, Any], *, slip: str = "straight", steps: int =
 def diagonal_blocks(network: dict[str, Any]) -> np.ndarray:
     """The blocks K_ii of every node, shape (N, 2, 2), in N / (Ntilde l0), as the kernel reads them."""
     scene = Scene.from_config(load_config(base_config(network)))
-    return np.array(scene.operators.K_blocks[scene.operators.diag], dtype=np.float64)
+    ops = scene.operators
+    return np.array(ops.K_table[ops.K_id[ops.diag]], dtype=np.float64)
 
 
 def anisotropy(k: np.ndarray) -> np.ndarray:

@@ -66,7 +66,9 @@ FORMAT = "slidernet-checkpoint"
 # 2: the threshold streams' surplus (surplus/<name>) and the tilt_uniforms stream.
 # 3: the kernel's own state under backend/<name>, written and read by its backend.
 # 4: named state (state/<field>, buffers/<name>, the backend's nodes/ and heaps/).
-VERSION = 4
+# 5: the scene's fingerprint digests K as the 2D kernels hold it (block ids and their table), and a
+#    triangular lattice's springs take its exact unit vectors: a version-4 run would not continue the same.
+VERSION = 5
 
 # Attributes written to the file (by name, or with special handling below).
 _SAVED = {"state", "mu", "buffers", "out", "rngs", "draws", "backend", "_tilted"}
@@ -305,7 +307,10 @@ def _check_same(path: Path, what: str, saved: Any, here: dict[str, Any]) -> None
 
 def _fingerprint(scene: Scene) -> dict[str, Any]:
     """What a continuation depends on in the scene, beyond the seed (JSON values)."""
-    net, K = scene.network, scene.K
+    net, ops = scene.network, scene.operators
+    # The kernel's own form of K: 1D CSR values, 2D block ids into the table of blocks.
+    K_arrays = (ops.indptr, ops.indices, ops.K_data) if isinstance(ops, kernels.Chain) else \
+        (ops.indptr, ops.indices, ops.K_id, ops.K_table)
     return {
         "kernel": scene.kernel,
         "n_nodes": int(net.n_nodes),
@@ -323,7 +328,7 @@ def _fingerprint(scene: Scene) -> dict[str, Any]:
         "slip_mode": int(scene.slip_mode),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
-        "K": _digest(K.indptr, K.indices, K.data),
+        "K": _digest(*K_arrays),
         "loads": _digest(scene.operators.g, net.normal_load, net.f_ext),
     }
 

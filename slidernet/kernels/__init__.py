@@ -27,7 +27,7 @@ with the plugin's ``sample`` in batches.
 
 from slidernet.kernels.chain import init_chain_heaps, run_chain
 from slidernet.kernels.pair import run_pair
-from slidernet.kernels.plane import init_plane_heaps, run_plane
+from slidernet.kernels.plane import init_plane_heaps, run_plane, stiffness_times
 from slidernet.kernels.state import (
     AVALANCHE_LIMIT,
     DONE,
@@ -76,5 +76,6 @@ __all__ = [
     "run_chain",
     "run_pair",
     "run_plane",
+    "stiffness_times",
     "tilt_test_pair",
 ]

@@ -247,11 +247,11 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
     budget. Used by the kernel and by the network tilt test.
     """
     fd = settings.mu_d * net.normal_load[i]
-    d = net.diag[i]  # the diagonal block K_ii
-    K = net.K_blocks
-    kxx = K[d, 0, 0]
-    kxy = K[d, 0, 1]
-    kyy = K[d, 1, 1]
+    b = net.K_id[net.diag[i]]  # the diagonal block K_ii
+    K = net.K_table
+    kxx = K[b, 0, 0]
+    kxy = K[b, 0, 1]
+    kyy = K[b, 1, 1]
     if settings.slip_mode == SLIP_EXACT:
         dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
         return nsteps >= 0, dux, duy
@@ -262,12 +262,13 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
 @kernel_jit(inline="always")
 def spread(net, a, i, dux, duy):
     """The forces a_j of node i's neighbours (and its own) after it moved by (dux, duy): a -= K du."""
-    K = net.K_blocks
+    K = net.K_table
     for p in range(net.indptr[i], net.indptr[i + 1]):
         j = net.indices[p]
+        b = net.K_id[p]
         # K is symmetric, so K_ji du_i = K_ij du_i with the stored row i.
-        a[j, 0] -= K[p, 0, 0] * dux + K[p, 0, 1] * duy
-        a[j, 1] -= K[p, 1, 0] * dux + K[p, 1, 1] * duy
+        a[j, 0] -= K[b, 0, 0] * dux + K[b, 0, 1] * duy
+        a[j, 1] -= K[b, 1, 0] * dux + K[b, 1, 1] * duy
 
 
 @kernel_jit(inline="always")
@@ -284,6 +285,22 @@ def move_node(net, st, nodes, i, dux, duy):
 def pair_force(net, nodes, theta):
     """The force along x on node 1 (the appendix's tilt test is for 1D pairs; the scene refuses it in 2D)."""
     return nodes.a[1, 0] + net.g[1, 0] * theta
+
+
+@kernel_jit()
+def stiffness_times(net, u, out):
+    """out = K u over the block rows of K (``out`` and ``u`` of shape (N, 2)): the forces' reset."""
+    K = net.K_table
+    for n in range(net.indptr.size - 1):
+        sx = 0.0
+        sy = 0.0
+        for p in range(net.indptr[n], net.indptr[n + 1]):
+            j = net.indices[p]
+            b = net.K_id[p]
+            sx += K[b, 0, 0] * u[j, 0] + K[b, 0, 1] * u[j, 1]
+            sy += K[b, 1, 0] * u[j, 0] + K[b, 1, 1] * u[j, 1]
+        out[n, 0] = sx
+        out[n, 1] = sy
 
 
 @kernel_jit()

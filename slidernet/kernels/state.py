@@ -229,12 +229,18 @@ class Chain(NamedTuple):
 
 
 class Plane(NamedTuple):
-    """A 2D network's operators: the block-CSR rows of K (2 x 2 blocks) and the loads."""
+    """A 2D network's operators: the block-CSR rows of K (2 x 2 blocks) and the loads.
+
+    Block K_ij, the entry p of row i, is ``K_table[K_id[p]]``: a lattice
+    stores each distinct block once (a few dozen of them, where one block per
+    entry took 224 MB at a million nodes), any other network one per entry.
+    """
 
     indptr: np.ndarray  # (N + 1,) int64
-    indices: np.ndarray  # (nnzb,) int64
-    K_blocks: np.ndarray  # (nnzb, 2, 2) blocks K_ij, in k0
-    diag: np.ndarray  # (N,) int64: position of K_ii in K_blocks
+    indices: np.ndarray  # (nnzb,) int32: block columns, sorted
+    K_id: np.ndarray  # (nnzb,) int32: row of K_table holding the block
+    K_table: np.ndarray  # (B, 2, 2) the distinct blocks of K, in k0
+    diag: np.ndarray  # (N,) int64: position of K_ii in the row (indices, K_id)
     g: np.ndarray  # (N, 2) thermal load
     normal_load: np.ndarray  # (N,)
     w: np.ndarray  # (N,)

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.spatial
 
 from slidernet.errors import ConfigError, param_error
+from slidernet.model.lattice import Lattice
 from slidernet.model.network import Network, chain
 
 __all__ = [
@@ -124,16 +125,6 @@ def _lattice_shape(shape: object, owner: str) -> tuple[int, int]:
     return rows, cols
 
 
-def _pairs(i: np.ndarray, j: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """Edges (E, 2) from candidate neighbours j (N, m) of nodes i (N,), kept where valid.
-
-    Candidates are listed in increasing j for each i, so boolean indexing in
-    row-major order yields the lexicographic order directly, with no sort.
-    """
-    src = np.broadcast_to(i[:, None], j.shape)[valid]
-    return np.column_stack([src, j[valid]])
-
-
 # --------------------------------------------------------------------------
 # Lattices
 # --------------------------------------------------------------------------
@@ -155,8 +146,9 @@ def square(shape: Sequence[int], Ntilde: float, **overrides: Any) -> Network:
 
     Returns
     -------
-    Network
-        2D network with N = rows * cols nodes at positions ``(col, row)`` in l0
+    Lattice
+        A :class:`~slidernet.model.lattice.Lattice` (a 2D Network that lists
+        its springs only on demand) with N = rows * cols nodes at positions ``(col, row)`` in l0
         (spacing 1), node index ``row * cols + col``, and
         E = rows (cols - 1) + cols (rows - 1) springs of length 1 (horizontal and
         vertical), free boundaries. Edges are ``(i, j)`` with i < j, sorted.
@@ -177,15 +169,8 @@ def square(shape: Sequence[int], Ntilde: float, **overrides: Any) -> Network:
     [[0, 1], [0, 3], [1, 2], [1, 4], [2, 5], [3, 4], [4, 5]]
     """
     rows, cols = _lattice_shape(shape, "square")
-    n = rows * cols
-    _check_overrides(overrides, n, rows * (cols - 1) + cols * (rows - 1), "square")
-    row, col = np.divmod(np.arange(n, dtype=np.int64), cols)
-    positions = np.column_stack([col.astype(float), row.astype(float)])
-    i = np.arange(n, dtype=np.int64)
-    # Candidates in increasing j: right (i + 1), then up (i + cols).
-    j = np.column_stack([i + 1, i + cols])
-    valid = np.column_stack([col < cols - 1, row < rows - 1])
-    return Network(positions=positions, edges=_pairs(i, j, valid), Ntilde=Ntilde, **overrides)
+    _check_overrides(overrides, rows * cols, rows * (cols - 1) + cols * (rows - 1), "square")
+    return Lattice("square", (rows, cols), Ntilde, **overrides)
 
 
 def triangular(shape: Sequence[int], Ntilde: float, **overrides: Any) -> Network:
@@ -204,10 +189,12 @@ def triangular(shape: Sequence[int], Ntilde: float, **overrides: Any) -> Network
 
     Returns
     -------
-    Network
-        2D network with N = rows * cols nodes, node index ``row * cols + col``,
-        at ``(col + (row % 2) / 2, row * sqrt(3) / 2)`` in l0: odd rows are
-        shifted right by 1/2, so every spring has length 1. Interior sliders
+    Lattice
+        A :class:`~slidernet.model.lattice.Lattice` (a 2D Network that lists
+        its springs only on demand) with N = rows * cols nodes, node index
+        ``row * cols + col``, at ``(col + (row % 2) / 2, row * sqrt(3) / 2)``
+        in l0: odd rows are shifted right by 1/2, so every spring has length 1
+        and one of three unit vectors, (1, 0) and (-+1/2, sqrt(3)/2), exactly. Interior sliders
         have 6 neighbours; boundaries are free. There are
         E = rows (cols - 1) + (rows - 1)(2 cols - 1) springs, ``(i, j)`` with
         i < j, sorted.
@@ -227,23 +214,8 @@ def triangular(shape: Sequence[int], Ntilde: float, **overrides: Any) -> Network
     True
     """
     rows, cols = _lattice_shape(shape, "triangular")
-    n = rows * cols
-    _check_overrides(overrides, n, rows * (cols - 1) + (rows - 1) * (2 * cols - 1), "triangular")
-    row, col = np.divmod(np.arange(n, dtype=np.int64), cols)
-    odd = (row % 2).astype(bool)
-    positions = np.column_stack([col + 0.5 * odd, row * (math.sqrt(3.0) / 2.0)])
-    i = np.arange(n, dtype=np.int64)
-    # Neighbours in the row above sit at x -+ 1/2: columns (col - 1, col) from an
-    # even row (the row above is shifted right), (col, col + 1) from an odd row.
-    up_left = i + cols - 1 + odd
-    has_up = row < rows - 1
-    j = np.column_stack([i + 1, up_left, up_left + 1])
-    valid = np.column_stack([
-        col < cols - 1,
-        has_up & (odd | (col > 0)),
-        has_up & (~odd | (col < cols - 1)),
-    ])
-    return Network(positions=positions, edges=_pairs(i, j, valid), Ntilde=Ntilde, **overrides)
+    _check_overrides(overrides, rows * cols, rows * (cols - 1) + (rows - 1) * (2 * cols - 1), "triangular")
+    return Lattice("triangular", (rows, cols), Ntilde, **overrides)
 
 
 # --------------------------------------------------------------------------

@@ -242,6 +242,29 @@ class Network:
             return self.stiffness_matrix().tobsr(blocksize=(d, d))
         return sp.bsr_matrix((data, indices, indptr), shape=(N * d, N * d), copy=False)
 
+    def stiffness_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """K's block rows, each block an id into a table of blocks: what the 2D kernels read.
+
+        Returns
+        -------
+        indptr : ndarray of int64, shape (N + 1,)
+        indices : ndarray of int32, shape (nnzb,)
+            Sorted block columns of each row; each row holds its diagonal block.
+        K_id : ndarray of int32, shape (nnzb,)
+            K_ij is ``K_table[K_id[p]]`` for the entry p of column j in row i.
+        K_table : ndarray, shape (B, d, d)
+            The blocks, in k0. Here one per entry (B = nnzb, ``K_id`` = 0, 1, ...);
+            a lattice (:class:`~slidernet.model.lattice.Lattice`) stores each
+            distinct block once.
+
+        >>> indptr, indices, K_id, K_table = chain(3, Ntilde=1e-7).stiffness_table()
+        >>> K_table[K_id[indptr[1]:indptr[2]]].ravel().tolist()
+        [-1.0, 2.0, -1.0]
+        """
+        K = self.stiffness_blocks()
+        return (K.indptr.astype(np.int64), K.indices.astype(np.int32),
+                np.arange(K.data.shape[0], dtype=np.int32), np.ascontiguousarray(K.data, dtype=np.float64))
+
     def thermal_load(self) -> np.ndarray:
         """g = B^T (k L kappa): force per unit theta/Ntilde, shape (N d,), node-major.
 

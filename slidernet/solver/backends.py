@@ -149,13 +149,17 @@ class NetworkBackend:
     def recompute(self, real: Realization) -> float:
         g = self.scene.operators.g
         a, u = self.nodes.a, self.nodes.u
-        fresh = (-(self.scene.K @ u.reshape(-1)) - g.reshape(-1) * real.thetas[0]).reshape(g.shape)
+        fresh = -self._K_times(u) - g * real.thetas[0]
         fresh += self._f_ext()
         drift = float(np.abs(fresh - a).max())
         a[...] = fresh
         real.state["since_recompute"] = 0
         self.rebuild_heaps(real)
         return drift
+
+    def _K_times(self, u: np.ndarray) -> np.ndarray:
+        """K u, in the shape of u."""
+        return self.scene.K @ u
 
     def flush_events(self, real: Realization) -> None:
         """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``."""
@@ -263,6 +267,12 @@ class PlaneBackend(NetworkBackend):
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {**super().records(T), "y_G": np.zeros(T)}
+
+    def _K_times(self, u: np.ndarray) -> np.ndarray:
+        # Over the kernels' block table: scipy would need one block per entry written out.
+        out = np.empty_like(u)
+        kernels.stiffness_times(self.scene.operators, u, out)
+        return out
 
 
 # The one place where a kernel's name is read: the scene's choice picks the backend.

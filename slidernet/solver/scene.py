@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
+import scipy.sparse as sp
 
 from slidernet.config import Config, build_network, choose_kernel
 from slidernet.errors import ConfigError
@@ -36,12 +37,13 @@ def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> n
 EVENT_CHUNK = 1 << 16  # rows of the event-catalogue buffer the kernel fills between returns
 
 
-def _operators(net: Network) -> tuple[str, Any, Chain | Plane]:
-    """The kernel family of a network, its stiffness matrix K and the operators the kernel runs on.
+def _operators(net: Network) -> tuple[str, Chain | Plane]:
+    """The kernel family of a network and the operators the kernel runs on.
 
     1D: the CSR rows of K (:class:`~slidernet.kernels.state.Chain`). 2D:
-    the block-CSR rows of its 2x2 blocks (:class:`~slidernet.kernels.state.Plane`),
-    which share memory with the returned ``scipy.sparse.bsr_matrix``.
+    the block rows of its 2x2 blocks as ids into a table of blocks
+    (:class:`~slidernet.kernels.state.Plane`; a lattice keeps each distinct
+    block once, :meth:`Network.stiffness_table`).
     Entries of g below 1e-12 of its largest entry are set to exactly zero:
     in a uniform lattice the interior loads cancel up to rounding, and a
     node with g_i = 0 is never driven directly (it stays out of the driving
@@ -55,7 +57,7 @@ def _operators(net: Network) -> tuple[str, Any, Chain | Plane]:
     unit_load = bool((net.normal_load == 1.0).all())
     if net.dim == 1:
         K = net.stiffness_matrix()
-        return "csr", K, Chain(
+        return "csr", Chain(
             indptr=K.indptr.astype(np.int64),
             indices=K.indices.astype(np.int64),
             K_data=K.data.astype(np.float64),
@@ -65,18 +67,31 @@ def _operators(net: Network) -> tuple[str, Any, Chain | Plane]:
             w=w,
             unit_load=unit_load,
         )
-    K = net.stiffness_blocks()
-    return "vec", K, _plane(K.indptr, K.indices, K.data, g.reshape(-1, 2).astype(np.float64), normal_load, w,
-                            unit_load)
+    indptr, indices, K_id, K_table = net.stiffness_table()
+    return "vec", _plane(indptr, indices, K_id, K_table, g.reshape(-1, 2).astype(np.float64), normal_load, w,
+                         unit_load)
 
 
-def _plane(indptr: np.ndarray, indices: np.ndarray, blocks: np.ndarray, g: np.ndarray, normal_load: np.ndarray,
-           w: np.ndarray, unit_load: bool) -> Plane:
-    """The 2D operators from the block-CSR rows of K: ``blocks`` (nnzb, 2, 2) of the rows ``indptr``."""
-    indptr = indptr.astype(np.int64)
-    indices = indices.astype(np.int64)
-    return Plane(indptr=indptr, indices=indices, K_blocks=blocks, diag=diagonal_positions(indptr, indices), g=g,
-                 normal_load=normal_load, w=w, unit_load=unit_load)
+def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: np.ndarray, g: np.ndarray,
+           normal_load: np.ndarray, w: np.ndarray, unit_load: bool) -> Plane:
+    """The 2D operators from K's block rows (``indptr``, ``indices``) and their blocks ``K_table[K_id]``."""
+    indptr = indptr.astype(np.int64, copy=False)
+    indices = indices.astype(np.int32, copy=False)
+    return Plane(indptr=indptr, indices=indices, K_id=K_id.astype(np.int32, copy=False), K_table=K_table,
+                 diag=diagonal_positions(indptr, indices), g=g, normal_load=normal_load, w=w, unit_load=unit_load)
+
+
+def stiffness_matrix(operators: Chain | Plane) -> sp.csr_matrix | sp.bsr_matrix:
+    """K as a scipy.sparse matrix from a kernel's operators (CSR in 1D, 2 x 2 blocks in 2D).
+
+    For checks and inspection: in 2D it writes out one block per entry,
+    which the kernels never need (224 MB at a million nodes).
+    """
+    n = operators.indptr.size - 1
+    if isinstance(operators, Chain):
+        return sp.csr_matrix((operators.K_data, operators.indices, operators.indptr), shape=(n, n))
+    return sp.bsr_matrix((operators.K_table[operators.K_id], operators.indices, operators.indptr),
+                         shape=(2 * n, 2 * n))
 
 
 class TiltOperators(NamedTuple):
@@ -99,8 +114,8 @@ class Scene:
         paper's two sliders, ``csr`` for other 1D networks, ``vec`` in 2D.
     operators : Chain or Plane
         The network's operators the kernels run on (see ``_operators``).
-    K : scipy.sparse matrix or None
-        The stiffness matrix, for the periodic recomputation of the forces.
+    K : scipy.sparse matrix
+        The stiffness matrix (a property, built from ``operators`` on first use).
     """
 
     network: Network
@@ -120,8 +135,15 @@ class Scene:
     catalogue: bool = False
     max_events: int = 0
     operators: Chain | Plane | None = None
-    K: Any = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
+    _K: Any = field(default=None, repr=False)
+
+    @property
+    def K(self) -> sp.csr_matrix | sp.bsr_matrix:
+        """The stiffness matrix as a scipy.sparse matrix (built on first use; see :func:`stiffness_matrix`)."""
+        if self._K is None:
+            self._K = stiffness_matrix(self.operators)
+        return self._K
 
     @property
     def do_tilt(self) -> bool:
@@ -131,7 +153,7 @@ class Scene:
     def tilt_operators(self) -> TiltOperators:
         """The operators of the network tilt test (built on first use; 1D padded to 2D)."""
         if self._tilt_operators is None:
-            self._tilt_operators = _tilt_operators(self.network)
+            self._tilt_operators = _tilt_operators(self.network, self.operators)
         return self._tilt_operators
 
     def settings(self) -> Settings:
@@ -144,7 +166,7 @@ class Scene:
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
-        family, K, operators = _operators(net)
+        family, operators = _operators(net)
         catalogue = "events" in cfg.observables
         kernel = choose_kernel(cfg.solver.kernel, net.is_two_slider(), net.dim, catalogue)
         if kernel != family and not (kernel == "pair" and net.is_two_slider()):
@@ -178,7 +200,6 @@ class Scene:
             catalogue=catalogue,
             max_events=cfg.solver.max_events,
             operators=operators,
-            K=K,
         )
 
 
@@ -192,19 +213,24 @@ def pair_tilt_applies(net: Network) -> bool:
             and not net.f_ext.any())
 
 
-def _tilt_operators(net: Network) -> TiltOperators:
-    """Block-CSR rows of K with 2 x 2 blocks (1D padded with zeros) for the network tilt test."""
-    K = net.stiffness_blocks()
+def _tilt_operators(net: Network, operators: Chain | Plane) -> TiltOperators:
+    """K's block rows with 2 x 2 blocks for the network tilt test: in 2D the scene's own, in 1D
+    padded with zeros; no thermal load (the test holds theta fixed)."""
     d = net.dim
-    blocks = np.zeros((K.data.shape[0], 2, 2))
-    blocks[:, :d, :d] = K.data
-    f_ext = np.zeros((net.n_nodes, 2))
-    f_ext[:, :d] = net.f_ext
+    N = net.n_nodes
     normal_load = net.normal_load.astype(np.float64)
-    plane = _plane(K.indptr, K.indices, blocks, np.zeros((net.n_nodes, 2)), normal_load,
-                   normal_load / normal_load.sum(), bool((normal_load == 1.0).all()))
+    if d == 2:
+        plane = operators._replace(g=np.zeros((N, 2)))
+    else:
+        indptr, indices, K_id, K_table = net.stiffness_table()
+        blocks = np.zeros((K_table.shape[0], 2, 2))
+        blocks[:, :1, :1] = K_table
+        plane = _plane(indptr, indices, K_id, blocks, np.zeros((N, 2)), normal_load,
+                       normal_load / normal_load.sum(), bool((normal_load == 1.0).all()))
+    f_ext = np.zeros((N, 2))
+    f_ext[:, :d] = net.f_ext
     return TiltOperators(net=plane, f_ext=f_ext, f_bar=float(f_ext[:, 0].sum() / net.normal_load.sum()),
-                         pair_rule=net.n_nodes == 2 and d == 1)
+                         pair_rule=N == 2 and d == 1)
 
 
 def tilt_avalanche_cap(n_nodes: int) -> int:
