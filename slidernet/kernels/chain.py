@@ -65,12 +65,15 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
 
 
 @kernel_jit(inline="always")
-def move_node(net, st, nodes, i, dux, duy):
-    """Displace node i by dux: its force offsets on the CSR row of K, and the centre of mass."""
+def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
+    """Displace node i by dux: the centre of mass, and the force offsets on the CSR row of K, each
+    node of the row re-keyed (``update_node``) as soon as its force is moved."""
     nodes.u[i] += dux
-    for p in range(net.indptr[i], net.indptr[i + 1]):
-        nodes.a[net.indices[p]] -= net.K_data[p] * dux
     st.x_G += dux * net.w[i]
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        j = net.indices[p]
+        nodes.a[j] -= net.K_data[p] * dux
+        update_node(net, nodes, heaps, j, theta)
 
 
 @kernel_jit(inline="always")

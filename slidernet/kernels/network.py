@@ -12,8 +12,9 @@ of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
-* ``move_node(net, st, nodes, i, du_x, du_y)``: apply it to u, to the force
-  offsets of the row of K, and to the centre of mass;
+* ``move_node(net, st, nodes, heaps, i, du_x, du_y, theta, update_node)``:
+  apply it to u, to the centre of mass and to the force offsets of the row
+  of K, re-keying each node of the row (``update_node``) as its force moves;
 * ``pair_force(net, nodes, theta)``: the spring force on node 1 of a pair
   (the appendix's tilt test).
 
@@ -66,10 +67,11 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     if not ok:
         return False
     log_event(st, catalogue, i, dux, duy)
-    move_node(net, st, nodes, i, dux, duy)
+    # The new threshold first, so that one pass over the row both moves the forces and re-keys the
+    # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
+    # as moving every force first).
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
-    for p in range(net.indptr[i], net.indptr[i + 1]):
-        update_node(net, nodes, heaps, net.indices[p], theta)
+    move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node)
     return True
 
 

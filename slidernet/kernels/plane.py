@@ -260,25 +260,33 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
 
 
 @kernel_jit(inline="always")
-def spread(net, a, i, dux, duy):
-    """The forces a_j of node i's neighbours (and its own) after it moved by (dux, duy): a -= K du."""
+def _pushed(net, a, p, j, dux, duy):
+    """a_j -= K_ji du_i for the entry p of row i (K is symmetric: K_ji = K_ij, the stored block)."""
     K = net.K_table
-    for p in range(net.indptr[i], net.indptr[i + 1]):
-        j = net.indices[p]
-        b = net.K_id[p]
-        # K is symmetric, so K_ji du_i = K_ij du_i with the stored row i.
-        a[j, 0] -= K[b, 0, 0] * dux + K[b, 0, 1] * duy
-        a[j, 1] -= K[b, 1, 0] * dux + K[b, 1, 1] * duy
+    b = net.K_id[p]
+    a[j, 0] -= K[b, 0, 0] * dux + K[b, 0, 1] * duy
+    a[j, 1] -= K[b, 1, 0] * dux + K[b, 1, 1] * duy
 
 
 @kernel_jit(inline="always")
-def move_node(net, st, nodes, i, dux, duy):
-    """Displace node i by (dux, duy): its force offsets on the block row of K, and the centre of mass."""
+def spread(net, a, i, dux, duy):
+    """The forces a_j of node i's neighbours (and its own) after it moved by (dux, duy): a -= K du."""
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        _pushed(net, a, p, net.indices[p], dux, duy)
+
+
+@kernel_jit(inline="always")
+def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
+    """Displace node i by (dux, duy): the centre of mass, and the force offsets on the block row of K,
+    each node of the row re-keyed (``update_node``) as soon as its force is moved."""
     nodes.u[i, 0] += dux
     nodes.u[i, 1] += duy
-    spread(net, nodes.a, i, dux, duy)
     st.x_G += dux * net.w[i]
     st.y_G += duy * net.w[i]
+    for p in range(net.indptr[i], net.indptr[i + 1]):
+        j = net.indices[p]
+        _pushed(net, nodes.a, p, j, dux, duy)
+        update_node(net, nodes, heaps, j, theta)
 
 
 @kernel_jit(inline="always")
