@@ -105,7 +105,7 @@ class Realization:
                                         for name in kernels.Series._fields})
 
     def recompute_forces(self) -> float:
-        """Recompute a = -K u - g theta(0) + f_ext from the displacements (sparse mat-vec).
+        """Recompute a = -K u - g theta(0) + f_ext from the displacements (a sparse product with K).
 
         Incremental updates of ``a`` accumulate rounding; this resets it and
         rebuilds the heaps. The pair kernel keeps no force: it forms
