@@ -1,7 +1,7 @@
 """slidernet against two plain-C yardsticks in the same run: one Markdown table of same-run ratios.
 
-    python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--sizes L ...] [--core 1] [--csv PATH]
-                                    [--no-delaunay] [--paper]
+    python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--repeat 3] [--sizes L ...] [--core 1]
+                                    [--csv PATH] [--no-delaunay] [--paper]
 
 The yardsticks are two plain C programs that solve the same model the
 straightforward way, on one core: ``twoslider_loop.c`` (the paper's two
@@ -60,6 +60,10 @@ step). The random streams differ, so the counts agree statistically, not to
 the bit: with 20 steps of a large lattice the work depends on the 20 draws
 of theta and differs by tens of percent between seeds.
 
+Rows 1 to 5 run ``--repeat`` times (default 3), slidernet and C alternating,
+and report the median of each figure with the ratio of each run: one run of
+a second or two moves by several per cent on a shared machine.
+
 ``--quick`` is a smoke run (10 000 steps for two sliders, 200 steps at
 32 x 32, ``--sizes 100``): its ratios are noisy. ``--csv PATH`` writes one
 line per row, with the numbers unformatted.
@@ -74,10 +78,12 @@ import math
 import os
 import re
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -288,6 +294,39 @@ def c_lattice(exe: Path, size: int, steps: int, core: int | None) -> dict[str, A
             "peak_GB": usage["peak_GB"], "cpu_share": usage["cpu"] / usage["wall"]}
 
 
+def _median(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Each numeric field's median over repeated runs (other fields from the first run)."""
+    out = dict(runs[0])
+    for key, value in runs[0].items():
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            out[key] = statistics.median(r[key] for r in runs)
+    return out
+
+
+def repeated(n: int, ours: Callable[[], dict[str, Any]], theirs: Callable[[], dict[str, Any]] | None
+             ) -> tuple[dict[str, Any], dict[str, Any] | None, list[float], list[float]]:
+    """Run slidernet's workload and then C's ``n`` times, alternating, so both see the same minutes.
+
+    Returns the median of each side's figures, and each side's rate run by run.
+    """
+    a, b = [], []
+    for _ in range(n):
+        a.append(ours())
+        if theirs is not None:
+            b.append(theirs())
+    return _median(a), (_median(b) if b else None), [r["rate"] for r in a], [r["rate"] for r in b]
+
+
+def _spread(ours: list[float], theirs: list[float]) -> str:
+    """' (median of n; runs: ...)' with the per-run ratios (or rates, in M/s, without C)."""
+    if len(ours) < 2:
+        return ""
+    if theirs:
+        runs = ", ".join(f"{x / y:.2f}" for x, y in zip(ours, theirs, strict=True))
+        return f" (median of {len(ours)}; ratio by run {runs})"
+    return f" (median of {len(ours)}; by run " + ", ".join(f"{x / 1e6:.1f}" for x in ours) + ")"
+
+
 # ---------------------------------------------------------------------------
 # the table
 
@@ -381,6 +420,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
     ap.add_argument("--no-delaunay", action="store_true",
                     help="leave out the irregular (Delaunay) network as large as the largest lattice")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="runs of rows 1 to 5, alternating slidernet and C, reported as medians (default 3)")
     ap.add_argument("--paper", action="store_true",
                     help="also time `slidernet paper` (full preset, all cores; minutes)")
     ap.add_argument("--child", nargs=2, metavar=("NAME", "JSON"), help=argparse.SUPPRESS)
@@ -411,46 +452,63 @@ def main(argv: list[str] | None = None) -> int:
         table = Table(why)
         shares: list[float] = []
 
+        n = max(1, args.repeat)
+
         # 1. two sliders, one core
-        ours = run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": False}, core)
-        theirs = c_pair(exe["twoslider_loop"], pair_steps, realizations, core) if exe else None
+        ours, theirs, r_ours, r_theirs = repeated(
+            n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": False}, core),
+            (lambda: c_pair(exe["twoslider_loop"], pair_steps, realizations, core)) if exe else None)
         shares += [ours["cpu_share"]] + ([theirs["cpu_share"]] if theirs else [])
         table.add(f"two sliders, {realizations} x {pair_steps:,} steps, one core", "M/s", ours["rate"],
                   theirs and theirs["rate"], target=">= 1.2", slips=(ours["slips"], theirs and theirs["slips"]),
-                  mu=(ours["mean_mu"], theirs and theirs["mean_mu"]))
+                  mu=(ours["mean_mu"], theirs and theirs["mean_mu"]),
+                  ours_text=f"{ours['rate'] / 1e6:.2f} M/s{_spread(r_ours, r_theirs)}")
 
         # 2. with the tilt test
-        tilt = run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": True}, core)
+        tilt, _, r_tilt, _ = repeated(
+            n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": True}, core),
+            None)
         shares.append(tilt["cpu_share"])
         table.add("two sliders + tilt test (mu_eff), one core", "M/s", tilt["rate"], c_applies=False,
                   target=">= 20 M/s", slips=(tilt["slips"], None),
-                  mu=(tilt["mean_mu"], None))
+                  mu=(tilt["mean_mu"], None), ours_text=f"{tilt['rate'] / 1e6:.2f} M/s{_spread(r_tilt, [])}")
 
-        # 3. 2 workers against 1 (slidernet.run, execution.workers)
-        ens = run_child("workers", {"steps": ens_steps, "realizations": ens_realizations, "workers": 2}, None)
-        one, two = ens["1"], ens["2"]
-        if one["slips"] != two["slips"]:
-            raise AssertionError(f"slidernet.run: {one['slips']} slips on 1 worker, {two['slips']} on 2")
+        # 3. 2 workers against 1 (slidernet.run, execution.workers); a speed-up per run, its median
+        runs = []
+        for _ in range(n):
+            ens = run_child("workers", {"steps": ens_steps, "realizations": ens_realizations, "workers": 2},
+                            None)
+            one, two = ens["1"], ens["2"]
+            if one["slips"] != two["slips"]:
+                raise AssertionError(f"slidernet.run: {one['slips']} slips on 1 worker, {two['slips']} on 2")
+            runs.append({"rate": two["rate"] / one["rate"], "one": one["rate"], "two": two["rate"],
+                         "share_one": one["cpu_share"], "share_two": two["cpu_share"], "slips": two["slips"]})
+        ens = _median(runs)
+        by_run = ", ".join(f"{r['rate']:.2f}" for r in runs)
         table.add(f"two sliders, {ens_realizations} x {ens_steps:,} steps, slidernet.run on 2 workers / 1",
-                  "x", two["rate"] / one["rate"], ratio="no C counterpart", target=">= 1.9",
-                  ours_text=f"{two['rate'] / one['rate']:.2f} x ({two['rate'] / 1e6:.1f} / "
-                            f"{one['rate'] / 1e6:.1f} M/s; CPU share {two['cpu_share']:.2f} / "
-                            f"{one['cpu_share']:.2f})", slips=(two["slips"], None))
+                  "x", ens["rate"], ratio="no C counterpart", target=">= 1.9",
+                  ours_text=f"{ens['rate']:.2f} x ({ens['two'] / 1e6:.1f} / {ens['one'] / 1e6:.1f} M/s; CPU share "
+                            f"{ens['share_two']:.2f} / {ens['share_one']:.2f}"
+                            + (f"; median of {n}, by run {by_run})" if n > 1 else ")"),
+                  slips=(ens["slips"], None))
 
         # 4. the small lattice
-        small = run_child("lattice", {"size": SMALL, "steps": small_steps}, core)
-        c_small = c_lattice(exe["lattice"], SMALL, small_steps, core) if exe else None
+        small, c_small, r_small, r_c_small = repeated(
+            n, lambda: run_child("lattice", {"size": SMALL, "steps": small_steps}, core),
+            (lambda: c_lattice(exe["lattice"], SMALL, small_steps, core)) if exe else None)
         shares += [small["cpu_share"]] + ([c_small["cpu_share"]] if c_small else [])
         table.add(f"triangular {SMALL} x {SMALL}, {small_steps} steps, kernel alone", "M/s", small["rate"],
                   c_small and c_small["rate"], target=">= 1.2",
                   slips=(small["slips"], c_small and c_small["slips"]),
-                  mu=(small["mean_mu"], c_small and c_small["mean_mu"]))
+                  mu=(small["mean_mu"], c_small and c_small["mean_mu"]),
+                  ours_text=f"{small['rate'] / 1e6:.2f} M/s{_spread(r_small, r_c_small)}")
 
         # 5. the large lattices
         large: dict[int, tuple[dict[str, Any], dict[str, Any] | None]] = {}
         for L in sizes:
-            big = run_child("lattice", {"size": L, "steps": big_steps}, core)
-            c_big = c_lattice(exe["lattice"], L, big_steps, core) if exe else None
+            big, c_big, _, _ = repeated(
+                n, lambda L=L: run_child("lattice", {"size": L, "steps": big_steps}, core),
+                (lambda L=L: c_lattice(exe["lattice"], L, big_steps, core)) if exe else None)
             shares += [big["cpu_share"]] + ([c_big["cpu_share"]] if c_big else [])
             large[L] = (big, c_big)
             label = f"triangular {L} x {L}, {big_steps} steps"
