@@ -302,17 +302,28 @@ def test_irregular_leaves_the_global_rng_alone():
     np.testing.assert_array_equal(np.random.get_state()[1], before)  # noqa: NPY002
 
 
-# The builder hands the points to Qhull in strips (for speed); the springs must be those of the
-# triangulation of the points in draw order.
+# The builder numbers the points along strips (for locality); they are the drawn points, and the
+# springs are those of their Delaunay triangulation (Qhull called here on the drawn order).
 @pytest.mark.parametrize("n", [300, 5000], ids=["n300", "n5000"])
 def test_irregular_geometry_and_delaunay_edges(n):
     net = irregular(n, NT, np.random.default_rng(2))
     pos = net.positions
     assert pos.shape == (n, 2)
     assert pos.min() >= 0 and pos.max() < math.sqrt(n)
-    np.testing.assert_array_equal(pos, np.random.default_rng(2).uniform(0, math.sqrt(n), (n, 2)))
+    drawn = np.random.default_rng(2).uniform(0, math.sqrt(n), (n, 2))
+    order = np.lexsort((pos[:, 0], pos[:, 1]))
+    np.testing.assert_array_equal(pos[order], drawn[np.lexsort((drawn[:, 0], drawn[:, 1]))])
+    # Numbered strip by strip (width 1 l0), each strip along x, alternately rightwards and leftwards.
+    strip = np.floor(pos[:, 1])
+    assert (np.diff(strip) >= 0).all()
+    x = np.where(strip % 2 == 0, pos[:, 0], -pos[:, 0])
+    assert (np.diff(x)[np.diff(strip) == 0] > 0).all()
+    # Neighbours are close in the numbering: about one strip (sqrt(n) nodes) apart at most, hull aside.
+    assert np.median(np.abs(np.diff(net.edges, axis=1))) < 2 * math.sqrt(n)
+    perm = np.random.default_rng(3).permutation(n)  # the triangulation does not depend on the order
+    pos_shuffled = pos[perm]
     expected = set()
-    for s in scipy.spatial.Delaunay(pos).simplices.tolist():
+    for s in perm[scipy.spatial.Delaunay(pos_shuffled).simplices].tolist():
         for a, b in ((0, 1), (1, 2), (0, 2)):
             expected.add((min(s[a], s[b]), max(s[a], s[b])))
     assert [tuple(e) for e in net.edges.tolist()] == sorted(expected)
