@@ -170,13 +170,13 @@ class Heaps(NamedTuple):
     (:func:`slidernet.kernels.network.turn`).
     """
 
-    node: np.ndarray  # (W, N) int64
+    node: np.ndarray  # (W, N) int32
     key: np.ndarray  # (W, N) float64
-    slot: np.ndarray  # (N, W) int64
+    slot: np.ndarray  # (N, W) int32
     size: np.ndarray  # (W,) int64
     active: np.ndarray  # (1,) int64: the driving tree kept up to date (UP or DOWN)
     stale: np.ndarray  # (N,) uint8: 1 if the other driving tree's key of the node is out of date
-    stale_nodes: np.ndarray  # (N,) int64: those nodes, in the order they were marked
+    stale_nodes: np.ndarray  # (N,) int32: those nodes, in the order they were marked
     n_stale: np.ndarray  # (1,) int64: how many
     tkey: np.ndarray  # (2, T) float64: the driving trees' keys
     twin: np.ndarray  # (2, T) int32: the node holding each key (leaves: their own node)
@@ -207,9 +207,10 @@ class Heaps(NamedTuple):
         twin = np.full((2, T), _TREE_PAD, np.int32)
         if sizes:
             twin[:, :int(driven.sum())] = np.flatnonzero(driven).astype(np.int32)
-        return cls(np.zeros((n_heaps, n_nodes), np.int64), np.zeros((n_heaps, n_nodes)),
-                   np.full((n_nodes, n_heaps), -1, np.int64), np.zeros(n_heaps, np.int64),
-                   np.full(1, UP, np.int64), np.zeros(n_nodes, np.uint8), np.zeros(n_nodes, np.int64),
+        # Node indices and slots in int32 (N < 2**31): slot is read for every re-keyed node.
+        return cls(np.zeros((n_heaps, n_nodes), np.int32), np.zeros((n_heaps, n_nodes)),
+                   np.full((n_nodes, n_heaps), -1, np.int32), np.zeros(n_heaps, np.int64),
+                   np.full(1, UP, np.int64), np.zeros(n_nodes, np.uint8), np.zeros(n_nodes, np.int32),
                    np.zeros(1, np.int64), np.full((2, T), -np.inf), twin, toff, leaf)
 
 
