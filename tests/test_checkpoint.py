@@ -245,9 +245,9 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     np.savez(tmp_path / "future.npz", **arrays)
     with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 5"):
         load_realization(scene, ss, tmp_path / "future.npz")
-    # Checkpoints of the layouts before the per-kernel backends (version 2) and before the named
-    # state (version 3: slot arrays ist and fst) and before K's block table (version 4) are refused,
-    # not misread.
+    # Checkpoints of the layouts before the per-kernel backends (version 2), before the named
+    # state (version 3: slot arrays ist and fst) and before the driving trees and K's block table
+    # (version 4: three heap rows) are refused, not misread.
     for old in (2, 3, 4):
         arrays["header"] = np.frombuffer(json.dumps({**header, "version": old}).encode(), np.uint8)
         np.savez(tmp_path / "old.npz", **arrays)

@@ -38,7 +38,8 @@ File layout (keys of the ``.npz``; every array numeric):
     (:mod:`slidernet.solver.backends`, version 3 on): nothing for the pair
     kernel; for the network kernels the per-node state (``nodes/a``,
     ``nodes/u``, ``nodes/node_slips``, ``nodes/avalanche_count``), the heaps
-    (``heaps/node``, ``heaps/key``, ``heaps/slot``, ``heaps/size``), the
+    (``heaps/node``, ``heaps/key``, ``heaps/slot``, ``heaps/size``, the driving trees
+    ``heaps/tkey``, ``heaps/twin``, ``heaps/toff``, ``heaps/leaf`` from version 5 on), the
     catalogue rows in the kernel's buffer (``events/buffer_ids``,
     ``events/buffer_values``: its first ``ev_pos`` rows;
     ``events/buffer_rows``, its size), the chunks already handed to Python
@@ -66,8 +67,8 @@ FORMAT = "slidernet-checkpoint"
 # 2: the threshold streams' surplus (surplus/<name>) and the tilt_uniforms stream.
 # 3: the kernel's own state under backend/<name>, written and read by its backend.
 # 4: named state (state/<field>, buffers/<name>, the backend's nodes/ and heaps/).
-# 5: the scene's fingerprint digests K as the 2D kernels hold it (block ids and their table), and a
-#    triangular lattice's springs take its exact unit vectors: a version-4 run would not continue the same.
+# 5: the driving events from tournament trees (heaps/tkey, twin, toff, leaf; one heap row, not three),
+#    and the scene's fingerprint digests K as the 2D kernels hold it (block ids and their table).
 VERSION = 5
 
 # Attributes written to the file (by name, or with special handling below).

@@ -13,10 +13,10 @@ Delta u = 2 (mu_min - mu_d) s.
   compiled for each geometry: 1D (``chain.py``: scalar forces, CSR rows of
   K) and 2D (``plane.py``: vector forces, 2x2 blocks of K).
 
-The network kernel finds the next driving event from two indexed heaps
+The network kernel finds the next driving event from two tournament trees
 keyed by each driven node's critical theta (one per direction of theta),
-and relaxes avalanches from a heap keyed by overload (``heap.py``); a slip
-updates only the slipped node and its neighbours, O(degree log N).
+and relaxes avalanches from an indexed heap keyed by overload (``heap.py``);
+a slip updates only the slipped node and its neighbours, O(degree log N).
 
 On a 2-node chain ``run_network`` performs the *same floating-point
 operations* as ``run_pair``, so the two agree to the bit (tested). All

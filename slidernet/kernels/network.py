@@ -8,7 +8,7 @@ the slip, how a slip moves the forces -- comes in as five functions of the
 geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
 of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 
-* ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heaps;
+* ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heap and trees;
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
@@ -33,13 +33,13 @@ from slidernet.kernels.heap import (
     close_t0,
     end_step,
     heap_clear,
-    heap_set,
     log_event,
     next_driving_event,
     open_driving_event,
     open_initial_relaxation,
     redraw_threshold,
     theta_direction,
+    tree_set,
     write_output,
 )
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, UNSTABLE, UP, kernel_jit
@@ -48,7 +48,7 @@ from slidernet.kernels.tilt import tilt_sample
 
 @kernel_jit(inline="always")
 def init_heaps(net, state, nodes, heaps, update_node):
-    """(Re)build the three heaps from scratch, O(N log N)."""
+    """(Re)build the unstable heap and the driving trees from scratch, O(N log N) at most."""
     st = state[0]
     heap_clear(heaps)
     for j in range(nodes.mu.size):
@@ -77,12 +77,12 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
 
 @kernel_jit(inline="always")
 def turn(net, nodes, heaps, s, critical_roots):
-    """Make the driving heap of theta's direction s the active one, up to date.
+    """Make the driving tree of theta's direction s the active one, up to date.
 
     When theta turns, the nodes re-keyed since the last turn get their key in
-    the heap that becomes active (their key in the other one is up to date:
-    it was the active heap). O(stale nodes log N), once per turn, instead of
-    a second sift at every update.
+    the tree that becomes active (their key in the other one is up to date:
+    it was the active tree). O(stale nodes log N), once per turn, instead of
+    a second update at every slip.
     """
     if s == 0.0:
         return  # theta stands still: no driving event in this step
@@ -95,9 +95,9 @@ def turn(net, nodes, heaps, s, critical_roots):
         heaps.stale[j] = 0
         dn, up = critical_roots(net, nodes, j)
         if want == UP:
-            heap_set(heaps, UP, j, -up, True)
+            tree_set(heaps, UP, j, -up)
         else:
-            heap_set(heaps, DOWN, j, dn, True)
+            tree_set(heaps, DOWN, j, dn)
     heaps.n_stale[0] = 0
 
 
@@ -126,7 +126,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
     nodes : Nodes
         The per-node state.
     heaps : Heaps
-        The three heaps, built by :func:`init_heaps`.
+        The unstable heap and the driving trees, built by :func:`init_heaps`.
     draws : Draws
         Thresholds to hand out, one per slip (and the tilt test's draws).
     catalogue : Catalogue

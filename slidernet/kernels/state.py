@@ -133,42 +133,85 @@ def new_state() -> np.ndarray:
     return np.zeros(1, dtype=STATE)
 
 
-# The three heaps of a network kernel (rows of Heaps.node / Heaps.key).
+# A network kernel's heap (row of Heaps.node / Heaps.key) and its two driving trees (rows of
+# Heaps.tkey / Heaps.twin).
 UNSTABLE = 0  # unstable nodes keyed by their overload |F_i| / (mu_s,i N_i)
-UP = 1  # driven nodes keyed by minus their upper critical theta (next event as theta rises)
-DOWN = 2  # driven nodes keyed by their lower critical theta (next event as theta falls)
+UP = 0  # driven nodes keyed by minus their upper critical theta (next event as theta rises)
+DOWN = 1  # driven nodes keyed by their lower critical theta (next event as theta falls)
+
+TREE_ARITY = 8  # children per node of a driving tree: 8 keys of float64 fill one 64-byte cache line
+_TREE_PAD = np.iinfo(np.int32).max  # the winner of a padding entry (key -inf): never a node
 
 
 class Heaps(NamedTuple):
-    """Indexed binary heaps (see :mod:`slidernet.kernels.heap`), W of them over N nodes.
+    """Indexed binary heaps and tournament trees (see :mod:`slidernet.kernels.heap`) over N nodes.
 
     ``node[w, h]`` is the node in slot h of heap w and ``key[w, h]`` its key,
     so that sifting reads contiguous memory; ``slot[node, w]`` is its slot or
     -1, node-major so that the W slots of a node share a cache line;
     ``size[w]`` is the size of heap w.
 
-    Of the two driving heaps (``UP``, ``DOWN``) only the one theta is moving
-    along, ``active[0]``, is kept up to date at every slip; a node re-keyed
-    meanwhile is listed in ``stale_nodes[:n_stale[0]]`` (and marked in
-    ``stale``), and the other heap is brought up to date for those nodes
-    when theta turns (:func:`slidernet.kernels.network.turn`).
+    The driving events of a network kernel come from two tournament trees
+    (rows ``UP`` and ``DOWN`` of ``tkey`` and ``twin``) over its L driven
+    nodes, each the leaf ``leaf[node]`` (leaves in node order; where every
+    node is driven ``leaf`` is empty and the leaf of node j is j). Each tree is
+    stored level by level from the leaves (level l from ``toff[l]`` to
+    ``toff[l + 1]``, padded to whole groups of ``TREE_ARITY`` entries with
+    key -inf): entry c of level l + 1 holds the key and the node (``twin``)
+    that lead the group c of level l, its entries ``TREE_ARITY c`` to
+    ``TREE_ARITY c + TREE_ARITY - 1``; the last level is the root. Trees of
+    heaps without driving events (the tilt test's) have no levels
+    (``toff == [0]``).
+
+    Of the two trees only the one theta is moving along, ``active[0]``, is
+    kept up to date at every slip; a node re-keyed meanwhile is listed in
+    ``stale_nodes[:n_stale[0]]`` (and marked in ``stale``), and the other
+    tree is brought up to date for those nodes when theta turns
+    (:func:`slidernet.kernels.network.turn`).
     """
 
-    node: np.ndarray  # (W, N) int64
+    node: np.ndarray  # (W, N) int32
     key: np.ndarray  # (W, N) float64
-    slot: np.ndarray  # (N, W) int64
+    slot: np.ndarray  # (N, W) int32
     size: np.ndarray  # (W,) int64
-    active: np.ndarray  # (1,) int64: the driving heap kept up to date (UP or DOWN)
-    stale: np.ndarray  # (N,) uint8: 1 if the other driving heap's key of the node is out of date
-    stale_nodes: np.ndarray  # (N,) int64: those nodes, in the order they were marked
+    active: np.ndarray  # (1,) int64: the driving tree kept up to date (UP or DOWN)
+    stale: np.ndarray  # (N,) uint8: 1 if the other driving tree's key of the node is out of date
+    stale_nodes: np.ndarray  # (N,) int32: those nodes, in the order they were marked
     n_stale: np.ndarray  # (1,) int64: how many
+    tkey: np.ndarray  # (2, T) float64: the driving trees' keys
+    twin: np.ndarray  # (2, T) int32: the node holding each key (leaves: their own node)
+    toff: np.ndarray  # (levels + 1,) int64: where each level starts; T at the end
+    leaf: np.ndarray  # (N,) int32: each node's leaf, or -1 if not driven; (0,) if all are driven or no trees
 
     @classmethod
-    def empty(cls, n_heaps: int, n_nodes: int) -> Heaps:
-        return cls(np.zeros((n_heaps, n_nodes), np.int64), np.zeros((n_heaps, n_nodes)),
-                   np.full((n_nodes, n_heaps), -1, np.int64), np.zeros(n_heaps, np.int64),
-                   np.full(1, UP, np.int64), np.zeros(n_nodes, np.uint8), np.zeros(n_nodes, np.int64),
-                   np.zeros(1, np.int64))
+    def empty(cls, n_heaps: int, n_nodes: int, driven: np.ndarray | None = None) -> Heaps:
+        """W = ``n_heaps`` empty heaps over ``n_nodes`` nodes, with driving trees over the nodes of the
+        boolean mask ``driven`` (shape (N,)) if given; their keys are set by the kernels' init."""
+        sizes = []
+        leaf = np.zeros(0, np.int32)
+        if driven is not None:
+            driven = np.asarray(driven, bool)
+            leaf = np.full(n_nodes, -1, np.int32)
+            n = int(driven.sum())
+            leaf[driven] = np.arange(n, dtype=np.int32)
+            if n == n_nodes:
+                leaf = np.zeros(0, np.int32)
+            while n > 1:
+                parents = -(-n // TREE_ARITY)
+                sizes.append(parents * TREE_ARITY)
+                n = parents
+            if n == 1:
+                sizes.append(1)
+        toff = np.concatenate([[0], np.cumsum(sizes, dtype=np.int64)]).astype(np.int64)
+        T = int(toff[-1])
+        twin = np.full((2, T), _TREE_PAD, np.int32)
+        if sizes:
+            twin[:, :int(driven.sum())] = np.flatnonzero(driven).astype(np.int32)
+        # Node indices and slots in int32 (N < 2**31): slot is read for every re-keyed node.
+        return cls(np.zeros((n_heaps, n_nodes), np.int32), np.zeros((n_heaps, n_nodes)),
+                   np.full((n_nodes, n_heaps), -1, np.int32), np.zeros(n_heaps, np.int64),
+                   np.full(1, UP, np.int64), np.zeros(n_nodes, np.uint8), np.zeros(n_nodes, np.int32),
+                   np.zeros(1, np.int64), np.full((2, T), -np.inf), twin, toff, leaf)
 
 
 class Draws(NamedTuple):
