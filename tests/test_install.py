@@ -65,3 +65,19 @@ def test_another_packages_numba_cache_is_left_alone(tmp_path):
     code = "import numba, slidernet.plugins.drivers; print(repr(numba.config.CACHE_DIR))"
     out = subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True, text=True)
     assert out.stdout.strip() == "''"
+
+
+def test_each_version_of_the_kernels_sources_has_its_own_cache_folder(tmp_path):
+    # numba checks a cached function against its own file only; a kernel inlines helpers of the
+    # other files, so an edit anywhere in kernels/ must lead to another folder.
+    import shutil
+
+    from slidernet.kernels import state
+
+    copy = tmp_path / "kernels"
+    shutil.copytree(Path(state.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    assert state.folder_digest(copy) == state.sources_digest()
+    assert state.cache_dir().endswith(state.sources_digest())
+    heap = copy / "heap.py"
+    heap.write_text(heap.read_text() + "\n# an edit\n")
+    assert state.folder_digest(copy) != state.sources_digest()

@@ -18,8 +18,11 @@ offset, as it does a slot of an array: the names cost nothing
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import NamedTuple
 
 import numba
@@ -51,17 +54,41 @@ def kernel_jit(**options) -> Callable:
     return cached_jit(**options)
 
 
-def cache_dir() -> str:
-    """Where numba keeps slidernet's compiled kernels.
+@functools.cache
+def sources_digest() -> str:
+    """A digest of the kernels' sources (every ``.py`` file of this folder), 16 hex digits.
 
-    ``NUMBA_CACHE_DIR`` when the user set it, else ``numba`` in the per-user
-    cache directory (``platformdirs.user_cache_dir("slidernet")``, e.g.
-    ``~/.cache/slidernet/numba`` on Linux). Never inside the installed
-    package: cache files left in ``site-packages/slidernet/`` by a
-    ``pip install .`` outlive a ``pip uninstall`` and then shadow an editable
-    install as an empty namespace package.
+    numba checks a cached function against its own file only, but a kernel
+    inlines helpers from the other files of this folder: after an edit of
+    ``heap.py`` alone, ``run_plane`` (in ``plane.py``) would load its old
+    machine code, with the old layout of the heaps (a segfault was seen).
+    Each version of the sources therefore gets its own cache folder.
     """
-    return os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
+    return folder_digest(Path(__file__).parent)
+
+
+def folder_digest(folder: Path) -> str:
+    """16 hex digits of the SHA-1 of the names and contents of the ``.py`` files in ``folder``."""
+    h = hashlib.sha1()
+    for path in sorted(folder.glob("*.py")):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def cache_dir() -> str:
+    """Where numba keeps slidernet's compiled kernels: a folder per version of their sources.
+
+    Under ``NUMBA_CACHE_DIR`` when the user set it, else under ``numba`` in
+    the per-user cache directory (``platformdirs.user_cache_dir("slidernet")``,
+    e.g. ``~/.cache/slidernet/numba/<sources_digest()>`` on Linux). Never
+    inside the installed package: cache files left in
+    ``site-packages/slidernet/`` by a ``pip install .`` outlive a
+    ``pip uninstall`` and then shadow an editable install as an empty
+    namespace package.
+    """
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
+    return os.path.join(base, sources_digest())
 
 
 def cached_jit(**options) -> Callable:
