@@ -233,7 +233,11 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
     """
     Fx = nodes.a[i, 0] + net.g[i, 0] * theta
     Fy = nodes.a[i, 1] + net.g[i, 1] * theta
-    absF = nodes.mu[i] * net.normal_load[i] if driving else math.sqrt(Fx * Fx + Fy * Fy)
+    if driving:
+        # mu * 1.0 == mu exactly: with unit loads the load's cold cache line is not read.
+        absF = nodes.mu[i] if net.unit_load else nodes.mu[i] * net.normal_load[i]
+    else:
+        absF = math.sqrt(Fx * Fx + Fy * Fy)
     return slip_under(net, settings, i, Fx, Fy, absF, absF)
 
 
@@ -246,7 +250,7 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
     ok is False if the exact motion did not come to rest within its step
     budget. Used by the kernel and by the network tilt test.
     """
-    fd = settings.mu_d * net.normal_load[i]
+    fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
     b = net.K_id[net.diag[i]]  # the diagonal block K_ii
     K = net.K_table
     kxx = K[b, 0, 0]
@@ -281,8 +285,10 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
     each node of the row re-keyed (``update_node``) as soon as its force is moved."""
     nodes.u[i, 0] += dux
     nodes.u[i, 1] += duy
-    st.x_G += dux * net.w[i]
-    st.y_G += duy * net.w[i]
+    # With unit loads every weight is the same 1/N: w[0], in cache, has the bits of w[i].
+    wi = net.w[0] if net.unit_load else net.w[i]
+    st.x_G += dux * wi
+    st.y_G += duy * wi
     for p in range(net.indptr[i], net.indptr[i + 1]):
         j = net.indices[p]
         _pushed(net, nodes.a, p, j, dux, duy)

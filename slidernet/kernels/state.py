@@ -314,7 +314,7 @@ class Plane(NamedTuple):
     g: np.ndarray  # (N, 2) thermal load
     normal_load: np.ndarray  # (N,)
     w: np.ndarray  # (N,)
-    unit_load: bool
+    unit_load: bool  # every N_i == 1, so every w_i == 1/N: neither array is read in the hot loop
 
 
 class Settings(NamedTuple):
