@@ -233,7 +233,11 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
     """
     Fx = nodes.a[i, 0] + net.g[i, 0] * theta
     Fy = nodes.a[i, 1] + net.g[i, 1] * theta
-    absF = nodes.mu[i] * net.normal_load[i] if driving else math.sqrt(Fx * Fx + Fy * Fy)
+    if driving:
+        # mu * 1.0 == mu exactly: with unit loads the load's cold cache line is not read.
+        absF = nodes.mu[i] if net.unit_load else nodes.mu[i] * net.normal_load[i]
+    else:
+        absF = math.sqrt(Fx * Fx + Fy * Fy)
     return slip_under(net, settings, i, Fx, Fy, absF, absF)
 
 
@@ -246,8 +250,8 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
     ok is False if the exact motion did not come to rest within its step
     budget. Used by the kernel and by the network tilt test.
     """
-    fd = settings.mu_d * net.normal_load[i]
-    b = net.K_id[net.diag[i]]  # the diagonal block K_ii
+    fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
+    b = block_of(net, net.diag[i])  # the diagonal block K_ii
     K = net.K_table
     kxx = K[b, 0, 0]
     kxy = K[b, 0, 1]
@@ -260,10 +264,20 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
 
 
 @kernel_jit(inline="always")
+def block_of(net, p):
+    """The row of ``net.K_table`` holding the block of entry p: p itself where every entry has its own.
+
+    Skipping K_id there (any network but a lattice) spares a load that the
+    block's own load would wait for, and K_id's cache lines (4 bytes per entry).
+    """
+    return p if net.block_per_entry else net.K_id[p]
+
+
+@kernel_jit(inline="always")
 def _pushed(net, a, p, j, dux, duy):
     """a_j -= K_ji du_i for the entry p of row i (K is symmetric: K_ji = K_ij, the stored block)."""
     K = net.K_table
-    b = net.K_id[p]
+    b = block_of(net, p)
     a[j, 0] -= K[b, 0, 0] * dux + K[b, 0, 1] * duy
     a[j, 1] -= K[b, 1, 0] * dux + K[b, 1, 1] * duy
 
@@ -281,8 +295,10 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
     each node of the row re-keyed (``update_node``) as soon as its force is moved."""
     nodes.u[i, 0] += dux
     nodes.u[i, 1] += duy
-    st.x_G += dux * net.w[i]
-    st.y_G += duy * net.w[i]
+    # With unit loads every weight is the same 1/N: w[0], in cache, has the bits of w[i].
+    wi = net.w[0] if net.unit_load else net.w[i]
+    st.x_G += dux * wi
+    st.y_G += duy * wi
     for p in range(net.indptr[i], net.indptr[i + 1]):
         j = net.indices[p]
         _pushed(net, nodes.a, p, j, dux, duy)
@@ -304,7 +320,7 @@ def stiffness_times(net, u, out):
         sy = 0.0
         for p in range(net.indptr[n], net.indptr[n + 1]):
             j = net.indices[p]
-            b = net.K_id[p]
+            b = block_of(net, p)
             sx += K[b, 0, 0] * u[j, 0] + K[b, 0, 1] * u[j, 1]
             sy += K[b, 1, 0] * u[j, 0] + K[b, 1, 1] * u[j, 1]
         out[n, 0] = sx

@@ -303,7 +303,9 @@ class Plane(NamedTuple):
 
     Block K_ij, the entry p of row i, is ``K_table[K_id[p]]``: a lattice
     stores each distinct block once (a few dozen of them, where one block per
-    entry took 224 MB at a million nodes), any other network one per entry.
+    entry took 224 MB at a million nodes), any other network one per entry,
+    ``K_id`` = 0, 1, ... (``block_per_entry``: the kernels then take block p
+    directly, :func:`slidernet.kernels.plane.block_of`).
     """
 
     indptr: np.ndarray  # (N + 1,) int64
@@ -314,7 +316,8 @@ class Plane(NamedTuple):
     g: np.ndarray  # (N, 2) thermal load
     normal_load: np.ndarray  # (N,)
     w: np.ndarray  # (N,)
-    unit_load: bool
+    unit_load: bool  # every N_i == 1, so every w_i == 1/N: neither array is read in the hot loop
+    block_per_entry: bool  # K_id == 0, 1, ..., nnzb - 1: the kernels then do not read K_id
 
 
 class Settings(NamedTuple):

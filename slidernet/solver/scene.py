@@ -77,8 +77,11 @@ def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: n
     """The 2D operators from K's block rows (``indptr``, ``indices``) and their blocks ``K_table[K_id]``."""
     indptr = indptr.astype(np.int64, copy=False)
     indices = indices.astype(np.int32, copy=False)
-    return Plane(indptr=indptr, indices=indices, K_id=K_id.astype(np.int32, copy=False), K_table=K_table,
-                 diag=diagonal_positions(indptr, indices), g=g, normal_load=normal_load, w=w, unit_load=unit_load)
+    K_id = K_id.astype(np.int32, copy=False)
+    per_entry = K_table.shape[0] == K_id.size and bool((K_id == np.arange(K_id.size)).all())
+    return Plane(indptr=indptr, indices=indices, K_id=K_id, K_table=K_table,
+                 diag=diagonal_positions(indptr, indices), g=g, normal_load=normal_load, w=w, unit_load=unit_load,
+                 block_per_entry=per_entry)
 
 
 def stiffness_matrix(operators: Chain | Plane) -> sp.csr_matrix | sp.bsr_matrix:
