@@ -67,7 +67,7 @@ def test_a_large_lattice_keeps_a_small_table_and_no_spring_arrays():
     _indptr, indices, K_id, table = lat.stiffness_table()
     assert table.shape[0] <= 3 + 64  # 3 spring classes and the distinct diagonal blocks
     assert indices.dtype == np.int32 and K_id.dtype == np.int32
-    assert "edges" not in vars(lat)  # never listed
+    assert "_springs" not in vars(lat)  # never listed
     assert lat.k.strides == (0,) and lat.kappa.strides == (0,)  # one number each, broadcast
 
 

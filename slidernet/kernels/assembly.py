@@ -189,7 +189,6 @@ def _lattice_rows(kind, rows, cols, n_classes):
     nnz = indptr[N]
     indices = np.empty(nnz, np.int32)
     K_id = np.empty(nnz, np.int32)
-    diag = np.empty(N, np.int64)
     fill = indptr[:N].copy()
     # Keys are < 4^3 per side: a dense map from key to the id of its diagonal block.
     seen = np.full(4096, -1, np.int64)
@@ -199,7 +198,6 @@ def _lattice_rows(kind, rows, cols, n_classes):
     for n in range(N):
         # The springs from lower-numbered nodes are in place: the diagonal comes next, then the rest.
         p = fill[n]
-        diag[n] = p
         indices[p] = n
         key = 64 * fwd[n] + bwd[n]
         if seen[key] < 0:
@@ -218,7 +216,7 @@ def _lattice_rows(kind, rows, cols, n_classes):
                 indices[fill[j]] = n
                 K_id[fill[j]] = c
                 fill[j] += 1
-    return indptr, indices, K_id, diag, node_id, keys[:n_keys].copy()
+    return indptr, indices, K_id, node_id, keys[:n_keys].copy()
 
 
 def _digits(seq: int) -> list[int]:
@@ -265,13 +263,11 @@ def lattice_operators(triangular: bool, rows: int, cols: int, k: float, unit: np
         Row of ``K_table`` holding K_ij.
     K_table : ndarray, shape (B, 2, 2)
         -b_c for each class c, then the distinct diagonal blocks.
-    diag : ndarray of int64, shape (N,)
-        Where each row keeps its diagonal block.
     g : ndarray, shape (N, 2)
         The thermal load of every node, in N per unit theta/Ntilde.
     """
     n_classes = unit.shape[0]
-    indptr, indices, K_id, diag, node_id, keys = _lattice_rows(int(triangular), int(rows), int(cols), n_classes)
+    indptr, indices, K_id, node_id, keys = _lattice_rows(int(triangular), int(rows), int(cols), n_classes)
     # The spring block formed as _assemble forms it: (k e_p) e_q.
     blocks = np.array([[[k * unit[c, p] * unit[c, q] for q in range(2)] for p in range(2)]
                        for c in range(n_classes)])
@@ -297,4 +293,4 @@ def lattice_operators(triangular: bool, rows: int, cols: int, k: float, unit: np
             pushed = pushed + load[c]
         g_table.append(pulled - pushed)
     g = np.asarray(g_table).reshape(-1, 2)[node_id]
-    return indptr, indices, K_id, np.asarray(table), diag, g
+    return indptr, indices, K_id, np.asarray(table), g

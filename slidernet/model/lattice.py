@@ -88,24 +88,20 @@ class Lattice(Network):
         self.Ntilde = Ntilde
         vectors = CLASS_VECTORS[kind]
         length = np.hypot(vectors[:, 0], vectors[:, 1])
-        self._class_length = length
+        # Every spring of either lattice has one length (1.0 in float64), whatever its direction.
+        self._spring_length = float(length[0])
         self._class_unit = vectors / length[:, None]
         E = self.n_edges
         self.k, k_one = _per_spring(k, E, "k", kind)
         if (self.k <= 0).any():
             raise param_error("k", kind, "> 0 for every spring", k)
         self.kappa, kappa_one = _per_spring(kappa, E, "kappa", kind)
-        if rest_length is None:
-            rest_one = bool((length == length[0]).all())
-            self.rest_length = np.broadcast_to(length[0], (E,)) if rest_one else None
-        else:
-            self.rest_length, rest_one = _per_spring(rest_length, E, "rest_length", kind)
-            if (self.rest_length <= 0).any():
-                raise param_error("rest_length", kind, "> 0 for every spring", rest_length)
+        self.rest_length, rest_one = _per_spring(self._spring_length if rest_length is None else rest_length, E,
+                                                 "rest_length", kind)
+        if (self.rest_length <= 0).any():
+            raise param_error("rest_length", kind, "> 0 for every spring", rest_length)
         # Every spring of a class alike: K and g from the stencil.
         self.uniform = k_one and kappa_one and rest_one
-        if self.rest_length is None:  # pragma: no cover - both lattices have one spring length
-            self.rest_length = self.lengths()
         N = self.n_nodes
         self.normal_load = _per_item(normal_load, N, "normal_load", kind)
         if (self.normal_load <= 0).any():
@@ -143,8 +139,9 @@ class Lattice(Network):
         odd = (row % 2).astype(bool)
         return np.column_stack([col + 0.5 * odd, row * _H])
 
+    @cached_property
     def _springs(self) -> tuple[np.ndarray, np.ndarray]:
-        """(edges (E, 2), class of each spring (E,)), edges ``(i, j)`` with i < j, sorted."""
+        """(edges (E, 2), class of each spring (E,)), edges ``(i, j)`` with i < j, sorted (listed on first use)."""
         rows, cols = self.rows, self.cols
         i = np.arange(self.n_nodes, dtype=np.int64)
         row, col = np.divmod(i, cols)
@@ -167,14 +164,14 @@ class Lattice(Network):
         cls = np.broadcast_to(np.arange(j.shape[1]), j.shape)[valid]
         return np.column_stack([src, j[valid]]), cls
 
-    @cached_property
+    @property
     def edges(self) -> np.ndarray:
         """Springs as pairs (i, j), i < j, sorted, shape (E, 2) (listed on first use)."""
-        return self._springs()[0]
+        return self._springs[0]
 
     def spring_classes(self) -> np.ndarray:
         """The direction class of every spring, shape (E,) (see :data:`CLASS_VECTORS`)."""
-        return self._springs()[1]
+        return self._springs[1]
 
     def unit_vectors(self) -> np.ndarray:
         """Unit vector of every spring, shape (E, 2): its class's, exactly."""
@@ -182,9 +179,7 @@ class Lattice(Network):
 
     def lengths(self) -> np.ndarray:
         """Length of every spring, shape (E,), in l0: its class's."""
-        if (self._class_length == self._class_length[0]).all():
-            return np.broadcast_to(self._class_length[0], (self.n_edges,))
-        return self._class_length[self.spring_classes()]  # pragma: no cover
+        return np.broadcast_to(self._spring_length, (self.n_edges,))
 
     # -- operators --------------------------------------------------------------------------
 
@@ -202,14 +197,14 @@ class Lattice(Network):
         """
         if not self.uniform:
             return super().stiffness_table()
-        indptr, indices, K_id, K_table, _diag, _g = self._stencil
+        indptr, indices, K_id, K_table, _g = self._stencil
         return indptr, indices, K_id, K_table
 
     def thermal_load(self) -> np.ndarray:
         """g, shape (2 N,), node-major (see :meth:`Network.thermal_load`); from the stencil when uniform."""
         if not self.uniform:
             return super().thermal_load()
-        return self._stencil[5].reshape(-1)
+        return self._stencil[-1].reshape(-1)
 
     def __repr__(self) -> str:
         return f"Lattice({self.kind!r}, shape=({self.rows}, {self.cols}), Ntilde={self.Ntilde!r})"
