@@ -235,10 +235,11 @@ def _figure(width: float = 7.0, height: float = 5.0, ncols: int = 1) -> Figure:
     return fig
 
 
-def _colors(k: int, cmap: str = "viridis") -> list[Any]:
+def _colors(k: int, cmap: str = "plasma") -> list[Any]:
     from matplotlib import colormaps
 
-    return [colormaps[cmap](x) for x in np.linspace(0.0, 0.85, k)] if k > 1 else [colormaps[cmap](0.0)]
+    # The light end of a sequential map is hard to see on white (viridis at 0.85 is yellow): stop at 0.78.
+    return [colormaps[cmap](x) for x in np.linspace(0.0, 0.78, k)] if k > 1 else [colormaps[cmap](0.0)]
 
 
 def _sci(x: float) -> str:
@@ -299,12 +300,12 @@ def _plot_fig1(ds: xr.Dataset, path: Path) -> None:
         h, = ax.plot(t[pos], m, "o", ms=3, mfc="none", color=c,
                      label=rf"$\sigma_\theta = {_sci(float(d['sigma_theta']))}$, "
                            rf"$\langle r\rangle = {float(d['r_mean']):.3g}$")
-        ax.plot(t[pos], d["mu_max_exact"].values[pos], "-", color=c, lw=1.2)
+        ax.plot(t[pos], d["mu_max_exact_given_n"].values[pos], "-", color=c, lw=1.2)
         ax.plot(t[pos], d["mu_max_leading"].values[pos], "--", color=c, lw=1.0)
         handles.append(h)
     handles += [
         Line2D([], [], color="0.3", ls="-", lw=1.2,
-               label=r"exact: $E[\max$ of $n+2$ draws$]$ at measured $\bar n(t)$"),
+               label=r"exact: $E[\max$ of $n+2$ draws$\,|\,n]$, averaged over the realizations' own $n(t)$"),
         Line2D([], [], color="0.3", ls="--", lw=1.0,
                label=r"eq. (mumaxth): $\bar\mu_s + \sigma_\mu\sqrt{2\ln(\langle r\rangle t/\tau_{th})}$"),
     ]
@@ -406,8 +407,11 @@ def _plot_fig3(ds: xr.Dataset, sigma_a: float, path: Path) -> None:
     ax.grid(alpha=0.3)
 
     s = ds["sigma_theta"].values
-    bx.errorbar(s, ds["r_mean"].values, yerr=ds["r_sem"].values, fmt="o", color="C0", mfc="none",
-                label="simulation (mean $\\pm$ sem)", zorder=3)
+    rel = float(np.max(ds["r_sem"].values / ds["r_mean"].values))
+    # Small markers, capped bars drawn over them: at these sems the bars would hide under 6-point markers.
+    bx.errorbar(s, ds["r_mean"].values, yerr=ds["r_sem"].values, fmt="o", ms=3, color="C0", mfc="none",
+                capsize=4, elinewidth=1.2, zorder=3,
+                label=rf"simulation (mean $\pm$ sem; sem $\leq$ {100 * rel:.2g} % of the mean)")
     grid = np.geomspace(s.min() / 1.2, s.max() * 1.2, 200)
     grid_off = grid[grid > 1.05 * MU_D * NTILDE]
     bx.plot(grid_off, theory.mean_rearrangements(grid_off, NTILDE, MU_D, MU_S_MEAN), "k-", lw=1,
@@ -447,6 +451,12 @@ def _fig4_data(runs: list[xr.Dataset], labels: list[str], cases: list[tuple[floa
     ds["mu_d"].attrs.update(long_name="dynamic friction coefficient", units="1")
     ds["ratio"].attrs.update(long_name="sigma_mu / (mean mu_s - mu_d)", units="1")
     ds["sigma_mu"].attrs.update(long_name="standard deviation of mu_s (before truncation)", units="1")
+    ds = ds.assign_coords(label=("case", [f"mu_d={md:g}, sigma_mu/(mean mu_s - mu_d)={r:g}, sigma_mu={sm:.3g}"
+                                          for md, r, sm in cases]))
+    ds["case"].attrs.update(long_name="run index: one (mu_d, ratio) pair per case",
+                            description="each case is one run of the tilt test; its mu_d, ratio, sigma_mu and "
+                                        "label are the coordinates along case")
+    ds["label"].attrs.update(long_name="what the case is")
     t = ds["t"].values.astype(float)
     sm = ds["sigma_mu"].values[:, None]
     ds["rt"] = (("case", "t"), ds["r_mean"].values[:, None] * t[None, :],
@@ -487,7 +497,7 @@ def _plot_fig4(ds: xr.Dataset, sigma_theta: float, path: Path) -> None:
             ax.fill_between(x[ok], (y - e)[ok], (y + e)[ok], color=c, alpha=0.25, lw=0)
             ax.plot(x[ok], y[ok], "-", color=c, lw=1.5)
         else:
-            ax.plot(x[ok], y[ok], "s", ms=4, mfc="none", color=c)
+            ax.errorbar(x[ok], y[ok], yerr=e[ok], fmt="s", ms=4, mfc="none", color=c, capsize=2, elinewidth=0.9)
         if float(d["ratio"]) not in theory_drawn:
             theory_drawn.add(float(d["ratio"]))
             ax.plot(x, d["mu_max_exact_phi"].values[pos], ":", color=c, lw=1.3)
@@ -498,7 +508,7 @@ def _plot_fig4(ds: xr.Dataset, sigma_theta: float, path: Path) -> None:
                           label=rf"lines: $\mu_d = {mu_ds[0]:g}$ (band $\pm$ sem)"))
     if len(mu_ds) > 1:
         handles.append(Line2D([], [], color="0.3", ls="none", marker="s", mfc="none",
-                              label=rf"open squares: $\mu_d = {mu_ds[1]:g}$"))
+                              label=rf"open squares: $\mu_d = {mu_ds[1]:g}$ (bars $\pm$ sem)"))
     handles.append(Line2D([], [], color="0.3", ls=":", lw=1.3,
                           label=r"$(\mu_\mathrm{max} - \bar\mu_s)/\sigma_\mu$, exact mean (reference)"))
     ax.axhline(0.0, color="0.6", lw=0.8)

@@ -1,0 +1,572 @@
+"""Readings of the appendix's virtual tilt test, side by side.
+
+The appendix of Géminard & Bertin (2010) copies "the values of mu_s,1, mu_s,2
+and of the force F_1->2" before each rearrangement and tilts the copy until
+the pair slides. Two choices of that text change what the test measures, and
+this module runs the paper's two sliders once per reading, on the same
+horizontal evolution (the same seeds), so that they can be compared:
+
+``"threshold"`` (slidernet's reading, :mod:`slidernet.kernels.tilt`)
+    The state is copied at theta_c, just before the rearrangement: the
+    weakest slider is exactly at its threshold, |F| = mu_min.
+``"after"``
+    The state is copied just after the rearrangement: F has dropped by
+    2 (mu_min - mu_d) and the slipped slider holds its new threshold.
+``"incline"``
+    The copy at theta_c, on an exact incline: the normal load is
+    N = m g cos(alpha) and the tangential one m g sin(alpha), while the
+    spring force keeps its value in absolute units (m g, the normal load
+    on the flat). At a given alpha the appendix's rules hold with every
+    force divided by N, that is with f/N = tan(alpha) and F/N = F / cos(alpha):
+    the spring force weighs more as the substrate tilts. Slider 1 starts at
+    sin(alpha) - mu_s,1 cos(alpha) = F, slider 2 at
+    sin(alpha) - mu_s,2 cos(alpha) = -F, whose roots are
+    alpha_i = arctan(mu_s,i) -/+ arcsin(F / sqrt(1 + mu_s,i^2)).
+``"incline_after"``
+    Both changes at once.
+
+The horizontal evolution is an independent, plain transcription of the
+solver's rules for two sliders (eq. `critique`, eq. `displacement`, the
+avalanche rule of docs/model.md): it reads the same random streams in the
+same order as :class:`slidernet.solver.Realization`, so that its
+``"threshold"`` reading reproduces ``slidernet.run``'s ``mu_eff``
+(``tests/test_tilt_readings.py`` checks it). The tilt test of the first
+two readings is the solver's own, :func:`slidernet.kernels.tilt.tilt_test_pair`.
+
+Units are the kernels': theta and u in Ntilde, forces in N (the normal load
+on the flat).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from slidernet.config import load_config
+from slidernet.ensemble.runner import realization_seeds
+from slidernet.errors import param_error
+from slidernet.kernels import Draws, new_state
+from slidernet.kernels.state import TILT_MAX_ITER, kernel_jit
+from slidernet.kernels.tilt import tilt_test_pair
+from slidernet.plugins.distributions import TruncatedStream
+from slidernet.solver import Scene, horizontal_draws, realization_streams
+
+READINGS = ("threshold", "after", "incline", "incline_after")
+_AFTER = {"threshold": False, "after": True, "incline": False, "incline_after": True}
+_INCLINE = {"threshold": False, "after": False, "incline": True, "incline_after": True}
+
+# Return codes of the loop.
+_DONE = 0
+_NEED_MU = 1
+_NEED_TILT = 2
+_TILT_LIMIT = 3
+_BATCH = 1 << 16
+
+
+@kernel_jit()
+def tilt_test_incline(st, draws, F, mu1, mu2, mu_d):
+    """The appendix's tilt test on an exact incline: tan(alpha_c), the tilt at which the pair slides.
+
+    Parameters
+    ----------
+    st : record of dtype STATE
+        Its ``tilt_mu_pos`` and ``tilt_u_pos`` are the read positions in
+        ``draws.tilt_mu`` and ``draws.tilt_u``; they advance only if the test
+        ends.
+    draws : Draws
+        The redrawn thresholds and the uniforms of the creep branch.
+    F : float
+        The spring force on slider 2 in units of the normal load on the flat
+        (m g); it keeps its absolute value as the substrate tilts.
+    mu1, mu2 : float
+        The thresholds.
+    mu_d : float
+        The dynamic coefficient.
+
+    Returns
+    -------
+    float
+        tan(alpha_c); -1.0 if the draw buffers ran out, -2.0 after
+        ``TILT_MAX_ITER`` iterations.
+    """
+    tilt_mu = draws.tilt_mu
+    tilt_u = draws.tilt_u
+    p_mu = st.tilt_mu_pos
+    p_u = st.tilt_u_pos
+    for _ in range(TILT_MAX_ITER):
+        a1 = math.atan(mu1) + math.asin(F / math.sqrt(1.0 + mu1 * mu1))
+        a2 = math.atan(mu2) - math.asin(F / math.sqrt(1.0 + mu2 * mu2))
+        if a1 <= a2:  # slider 1 moves first (ties: lowest index)
+            i = 1
+            alpha = a1
+            bound = mu_d - 0.5 * (mu1 - mu2)
+        else:
+            i = 2
+            alpha = a2
+            bound = mu_d + 0.5 * (mu1 - mu2)
+        f = math.tan(alpha)  # the tangential load per unit normal load at alpha
+        c = math.cos(alpha)
+        FN = F / c  # the spring force per unit normal load at alpha
+        if f >= bound:  # eq. `stab`: the other slider moves too
+            if f > mu_d:
+                st.tilt_mu_pos = p_mu
+                st.tilt_u_pos = p_u
+                return f
+            if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
+                return -1.0
+            mu1 = tilt_mu[p_mu]
+            mu2 = tilt_mu[p_mu + 1]
+            p_mu += 2
+            lo = f - mu1
+            FN = lo + ((mu2 - f) - lo) * tilt_u[p_u]
+            p_u += 1
+        else:
+            if p_mu + 1 > tilt_mu.size:
+                return -1.0
+            if i == 1:
+                FN += 2.0 * (mu1 - mu_d)
+                mu1 = tilt_mu[p_mu]
+            else:
+                FN -= 2.0 * (mu2 - mu_d)
+                mu2 = tilt_mu[p_mu]
+            p_mu += 1
+        F = FN * c
+    return -2.0
+
+
+@kernel_jit()
+def _test(st, draws, F, mu1, mu2, mu_d, incline):
+    if incline:
+        return tilt_test_incline(st, draws, F, mu1, mu2, mu_d)
+    return tilt_test_pair(st, draws, F, mu1, mu2, mu_d)
+
+
+@kernel_jit()
+def _sample(st, draws, F, mu1, mu2, mu_d, incline, k, f_sum, f_sq, f_count):
+    """One test, its sample added to bin k; returns a loop code."""
+    f = _test(st, draws, F, mu1, mu2, mu_d, incline)
+    if f == -1.0:
+        return _NEED_TILT
+    if f == -2.0:
+        return _TILT_LIMIT
+    f_sum[k] += f
+    f_sq[k] += f * f
+    f_count[k] += 1
+    return _DONE
+
+
+@kernel_jit()
+def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, f_sum, f_sq, f_count):
+    """Two sliders through ``thetas``, one tilt test per rearrangement (and one at t = 0).
+
+    Parameters
+    ----------
+    thetas : ndarray, shape (steps + 1,)
+        theta(t_q) / Ntilde.
+    bins : ndarray of int64, shape (steps,)
+        The output bin of the tests made during step q (theta from t_q to t_q+1);
+        the test at t = 0 goes to bin 0.
+    mu : ndarray, shape (2,)
+        (mu_s,1, mu_s,2), updated in place.
+    state : ndarray of dtype STATE, shape (1,)
+        q, u, theta, started, pending, n_slips and the read positions.
+    draws : Draws
+        Thresholds, one per slip, and the tilt test's draws.
+    mu_d : float
+        The dynamic coefficient.
+    after : bool
+        Test the state just after each rearrangement instead of just before.
+    incline : bool
+        Use :func:`tilt_test_incline` instead of the appendix's linear test.
+    f_sum, f_sq, f_count : ndarray, shape (T,)
+        Per bin: the sum of the samples, of their squares, and their number.
+
+    Returns
+    -------
+    int
+        0 at the end of ``thetas``; 1 or 2 when the thresholds or the tilt
+        draws ran out (refill and call again: nothing was lost); 3 if a test
+        did not end.
+    """
+    st = state[0]
+    steps = thetas.size - 1
+    if st.started == 0:
+        code = _sample(st, draws, st.theta - st.u, mu[0], mu[1], mu_d, incline, 0, f_sum, f_sq, f_count)
+        if code != _DONE:
+            return code
+        st.started = 1
+    while True:
+        if st.pending:
+            # An avalanche at fixed theta: the most overloaded slider slips (ties: lowest index).
+            F = st.theta - st.u
+            aF = abs(F)
+            un0 = aF > mu[0]
+            un1 = aF > mu[1]
+            if un1 and (not un0 or aF / mu[1] > aF / mu[0]):
+                i = 1
+            elif un0:
+                i = 0
+            else:
+                st.pending = 0
+                continue
+            du = 2.0 * (aF - mu_d) * (1.0 if F > 0.0 else -1.0)
+            u_new = st.u + du if i == 1 else st.u - du
+            theta_now = st.theta
+            k = bins[st.q] if st.q < steps else bins[steps - 1]
+        else:
+            if st.q >= steps:
+                return _DONE
+            a = thetas[st.q]
+            b = thetas[st.q + 1]
+            s = 1.0 if b > a else (-1.0 if b < a else 0.0)
+            # The weakest slider yields when s (theta - u) reaches its threshold (eq. `critique`);
+            # ties of the rounded theta_c go to the lowest index.
+            i = 1 if mu[1] < mu[0] else 0
+            tc = st.u + s * mu[i]
+            if i == 1 and st.u + s * mu[0] == tc:
+                i = 0
+            if s * tc < s * st.theta:
+                tc = st.theta  # rounding: already at the threshold
+            if s == 0.0 or s * b < s * tc:
+                st.q += 1
+                st.theta = b
+                continue
+            F = tc - st.u
+            du = 2.0 * (mu[i] - mu_d) * s
+            u_new = st.u + du
+            theta_now = tc
+            k = bins[st.q]
+        if st.mu_pos >= draws.mu.size:
+            return _NEED_MU
+        new = draws.mu[st.mu_pos]
+        if after:
+            m0 = new if i == 0 else mu[0]
+            m1 = new if i == 1 else mu[1]
+            code = _sample(st, draws, theta_now - u_new, m0, m1, mu_d, incline, k, f_sum, f_sq, f_count)
+        else:
+            code = _sample(st, draws, F, mu[0], mu[1], mu_d, incline, k, f_sum, f_sq, f_count)
+        if code != _DONE:
+            return code
+        st.theta = theta_now
+        st.u = u_new
+        mu[i] = new
+        st.mu_pos += 1
+        st.n_slips += 1
+        aF = abs(st.theta - st.u)
+        st.pending = 1 if (aF > mu[0] or aF > mu[1]) else 0
+
+
+def _bins(out_steps: np.ndarray, steps: int) -> np.ndarray:
+    """Bin of the tests made during step q: the first recorded time at or after t_q+1."""
+    return np.searchsorted(out_steps, np.arange(1, steps + 1), side="left").astype(np.int64)
+
+
+def realization_readings(scene: Scene, seed_seq: np.random.SeedSequence, reading: str) -> dict[str, np.ndarray]:
+    """One realization of the two sliders with one reading of the tilt test.
+
+    Parameters
+    ----------
+    scene : Scene
+        A two-slider scene (its driver, thresholds, mu_d and recorded times).
+    seed_seq : numpy.random.SeedSequence
+        The realization's seed: the same streams as ``slidernet.run``'s
+        realization with this seed.
+    reading : str
+        One of :data:`READINGS`.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``f_sum``, ``f_sq``, ``f_count`` per recorded time (shape (T,)) and
+        ``n``, the number of rearrangements at the end (shape ()).
+    """
+    if reading not in READINGS:
+        raise param_error("reading", "realization_readings", f"one of {READINGS}", reading)
+    rngs = realization_streams(seed_seq)
+    streams = {name: TruncatedStream(scene.distribution, rngs[name]) for name in ("thresholds", "tilt")}
+    thetas, mu, batches = horizontal_draws(scene, rngs, streams["thresholds"])
+    draws = Draws(next(batches), streams["tilt"].take(_BATCH), rngs["tilt_uniforms"].random(_BATCH))
+    state = new_state()
+    st = state.view(np.recarray)[0]
+    st.theta = thetas[0]
+    st.u = thetas[0]  # the spring at rest at theta(0)
+    T = scene.out_steps.size
+    f_sum, f_sq, f_count = np.zeros(T), np.zeros(T), np.zeros(T, np.int64)
+    bins = _bins(scene.out_steps, scene.steps)
+    mu_d = float(scene.mu_d)
+    while True:
+        code = run_readings(thetas, bins, mu, state, draws, mu_d, _AFTER[reading], _INCLINE[reading],
+                            f_sum, f_sq, f_count)
+        if code == _DONE:
+            break
+        if code == _NEED_MU:
+            draws = draws._replace(mu=np.concatenate([draws.mu[st.mu_pos:], next(batches)]))
+            st.mu_pos = 0
+        elif code == _NEED_TILT:
+            draws = draws._replace(tilt_mu=np.concatenate([draws.tilt_mu[st.tilt_mu_pos:],
+                                                           streams["tilt"].take(_BATCH)]),
+                                   tilt_u=np.concatenate([draws.tilt_u[st.tilt_u_pos:],
+                                                          rngs["tilt_uniforms"].random(_BATCH)]))
+            st.tilt_mu_pos = 0
+            st.tilt_u_pos = 0
+        else:
+            raise RuntimeError(f"A tilt test ({reading!r}) did not end within {TILT_MAX_ITER} iterations.")
+    return {"f_sum": f_sum, "f_sq": f_sq, "f_count": f_count, "n": np.int64(st.n_slips)}
+
+
+def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Dataset:
+    """mu_eff(t) of a two-slider configuration under each reading of the tilt test.
+
+    Parameters
+    ----------
+    config : dict
+        A configuration of the paper's two sliders (as for ``slidernet.run``);
+        its seed and realizations give the runs (realization r gets the r-th
+        child of ``SeedSequence(seed)``, as in ``slidernet.run``).
+    which : sequence of str
+        The readings, from :data:`READINGS`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (reading, t): ``mu_eff`` (the samples of the bin pooled over
+        realizations, as ``slidernet.run``'s), ``mu_eff_sem`` (the standard
+        error of the realizations' bin means, the honest spread), ``count``;
+        ``r_mean``, the measured rearrangements per tau_th (the first
+        reading's n at the end over the duration, averaged over realizations).
+
+    Examples
+    --------
+    >>> cfg = {"seed": 1, "realizations": 2, "steps": 50, "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...        "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.02}},
+    ...        "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}
+    >>> ds = readings(cfg, ["threshold", "incline"])
+    >>> ds["mu_eff"].dims, bool((ds["mu_eff"] > 0.5).all())
+    (('reading', 't'), True)
+    """
+    bad = [w for w in which if w not in READINGS]
+    if bad or not which:
+        raise param_error("which", "readings", f"a non-empty list from {READINGS}", list(which))
+    cfg = dict(config)
+    cfg["observables"] = sorted(set(cfg.get("observables", ["n", "mu_max"])) | {"mu_eff"})
+    model = load_config(cfg)
+    scene = Scene.from_config(model)
+    if scene.kernel != "pair":
+        raise param_error("network.kind", "readings", "'two_slider'", cfg.get("network", {}).get("kind"))
+    seeds = realization_seeds(model.seed, model.realizations)
+    T = scene.out_steps.size
+    mu_eff = np.full((len(which), T), np.nan)
+    sem = np.full((len(which), T), np.nan)
+    count = np.zeros((len(which), T), np.int64)
+    n_end = np.zeros(model.realizations)
+    for w, reading in enumerate(which):
+        runs = [realization_readings(scene, s, reading) for s in seeds]
+        tot = sum(r["f_sum"] for r in runs)
+        cnt = sum(r["f_count"] for r in runs)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mu_eff[w] = tot / cnt
+            means = np.array([r["f_sum"] / r["f_count"] for r in runs])
+        good = np.isfinite(means)
+        m = good.sum(axis=0)
+        dev = np.where(good, means - np.nanmean(np.where(good, means, np.nan), axis=0), 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sem[w] = np.sqrt((dev ** 2).sum(axis=0) / (m - 1) / m)
+        count[w] = cnt
+        if w == 0:
+            n_end = np.array([float(r["n"]) for r in runs])
+    t = scene.out_steps.astype(float)
+    ds = xr.Dataset(
+        {"mu_eff": (("reading", "t"), mu_eff, {"long_name": "tan(alpha_c), pooled over tests and realizations",
+                                               "units": "1"}),
+         "mu_eff_sem": (("reading", "t"), sem, {"long_name": "standard error over realizations", "units": "1"}),
+         "count": (("reading", "t"), count, {"long_name": "tilt tests in the bin", "units": "1"})},
+        coords={"reading": list(which), "t": ("t", t, {"units": "tau_th"})},
+        attrs={"realizations": model.realizations, "seed": str(model.seed)},
+    )
+    ds["r_mean"] = ((), float(n_end.mean() / scene.steps), {"long_name": "rearrangements per tau_th",
+                                                             "units": "1/tau_th"})
+    return ds
+
+
+# ---------------------------------------------------------------------------
+# The study of the reproduction report: the paper's Fig. 5 under each reading
+
+MU_S_MEAN = 0.6
+CASES = tuple((mu_d, ratio) for mu_d in (0.5, 0.4) for ratio in (0.1, 0.2, 0.3))
+
+
+def case_config(mu_d: float, ratio: float, steps: int, realizations: int, seed: int) -> dict[str, Any]:
+    """The paper's Fig. 5 run at (mu_d, sigma_mu / (mean mu_s - mu_d)): Ntilde = 1e-7, sigma_theta = 1e-6."""
+    return {
+        "seed": int(seed), "realizations": int(realizations), "steps": int(steps), "record": "log",
+        "log_points_per_decade": 10, "observables": ["n", "mu_max", "mu_eff"],
+        "network": {"kind": "two_slider", "Ntilde": 1e-7},
+        "friction": {"mu_d": float(mu_d),
+                     "static": {"name": "gaussian", "mean": MU_S_MEAN, "std": float(ratio * (MU_S_MEAN - mu_d))}},
+        "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6},
+    }
+
+
+def study(steps: int, realizations: int, seed: int = 300, cases: Sequence[tuple[float, float]] = CASES,
+          which: Sequence[str] = READINGS, progress: bool = True) -> xr.Dataset:
+    """:func:`readings` for every case: a dataset over (case, reading, t), with phi.
+
+    phi = (mu_eff - mean mu_s) / sigma_mu, the paper's ordinate.
+
+    Case k runs with seed ``seed + k``.
+    """
+    from tqdm.auto import tqdm
+
+    runs = []
+    for k, (mu_d, ratio) in enumerate(tqdm(cases, disable=not progress, desc="cases")):
+        ds = readings(case_config(mu_d, ratio, steps, realizations, seed + k), which)
+        sigma_mu = ratio * (MU_S_MEAN - mu_d)
+        ds["phi"] = (ds["mu_eff"] - MU_S_MEAN) / sigma_mu
+        ds["phi_sem"] = ds["mu_eff_sem"] / sigma_mu
+        ds["rt"] = ds["r_mean"] * ds["t"]
+        runs.append(ds.expand_dims(case=[k]))
+    out = xr.concat(runs, dim="case")
+    out = out.assign_coords(mu_d=("case", [c[0] for c in cases]), ratio=("case", [c[1] for c in cases]),
+                            sigma_mu=("case", [c[1] * (MU_S_MEAN - c[0]) for c in cases]))
+    out["mu_d"].attrs.update(long_name="dynamic friction coefficient mu_d")
+    out["ratio"].attrs.update(long_name="sigma_mu / (mean mu_s - mu_d)")
+    out["sigma_mu"].attrs.update(long_name="standard deviation of mu_s before truncation")
+    out["phi"].attrs.update(long_name="(mu_eff - mean mu_s) / sigma_mu", units="1")
+    out["rt"].attrs.update(long_name="<r> t, the typical number of rearrangements", units="1")
+    out.attrs.update(steps=int(steps), realizations=int(realizations), seed=int(seed),
+                     title="The appendix's tilt test under four readings (Fig. 5 of Geminard & Bertin 2010)")
+    return out
+
+
+def _log_slope(t: np.ndarray, y: np.ndarray, e: np.ndarray) -> tuple[float, float]:
+    """Weighted least-squares slope of y against log10 t (per decade) and its standard error."""
+    ok = (t >= 1) & np.isfinite(y) & np.isfinite(e) & (e > 0)
+    x = np.log10(t[ok])
+    w = 1.0 / e[ok] ** 2
+    A = np.vstack([np.ones_like(x), x]).T
+    cov = np.linalg.inv(A.T @ (A * w[:, None]))
+    beta = cov @ (A.T @ (w * y[ok]))
+    return float(beta[1]), float(np.sqrt(cov[1, 1]))
+
+
+def claims(ds: xr.Dataset) -> dict[str, Any]:
+    """The paper's claims on Fig. 5, measured under each reading.
+
+    For every case and reading: mu_eff at t = 1 and at the last time, the
+    relative change in per cent, and the slope of mu_eff against log10 t
+    (per decade, weighted by the standard errors). For every ratio: how well
+    the two mu_d collapse, as the mean of (Delta phi)^2 / (sem_1^2 + sem_2^2)
+    over the common range of <r> t (about 1 for a collapse within the errors).
+    """
+    res: dict[str, Any] = {"cases": [], "collapse": []}
+    t = ds["t"].values
+    first = int(np.searchsorted(t, 1.0))
+    for k in range(ds.sizes["case"]):
+        d = ds.isel(case=k)
+        for reading in ds["reading"].values:
+            r = d.sel(reading=reading)
+            y, e = r["mu_eff"].values, r["mu_eff_sem"].values
+            slope, slope_sem = _log_slope(t, y, e)
+            res["cases"].append({
+                "mu_d": float(d["mu_d"]), "ratio": float(d["ratio"]), "sigma_mu": float(d["sigma_mu"]),
+                "reading": str(reading), "mu_eff_t1": float(y[first]), "mu_eff_t1_sem": float(e[first]),
+                "mu_eff_end": float(y[-1]), "mu_eff_end_sem": float(e[-1]), "t_end": float(t[-1]),
+                "change_percent": float(100 * (y[-1] - y[first]) / y[first]),
+                "change_percent_sem": float(100 * np.hypot(e[-1], e[first]) / y[first]),
+                "slope_per_decade": slope, "slope_per_decade_sem": slope_sem,
+                "phi_end": float(r["phi"].values[-1]),
+            })
+    for ratio in sorted(set(ds["ratio"].values.tolist())):
+        ks = [k for k in range(ds.sizes["case"]) if float(ds["ratio"].values[k]) == ratio]
+        if len(ks) != 2:
+            continue
+        a, b = ds.isel(case=ks[0]), ds.isel(case=ks[1])
+        for reading in ds["reading"].values:
+            ra, rb = a.sel(reading=reading), b.sel(reading=reading)
+            xa, xb = ra["rt"].values, rb["rt"].values
+            ok = (ra["t"].values >= 1) & (xa >= xb[ra["t"].values >= 1].min()) & (xa <= xb.max())
+            ok &= np.isfinite(ra["phi"].values)
+            lx = np.log(xb[rb["t"].values >= 1])
+            yb = np.interp(np.log(xa[ok]), lx, rb["phi"].values[rb["t"].values >= 1])
+            eb = np.interp(np.log(xa[ok]), lx, rb["phi_sem"].values[rb["t"].values >= 1])
+            dphi = ra["phi"].values[ok] - yb
+            chi2 = float(np.mean(dphi ** 2 / (ra["phi_sem"].values[ok] ** 2 + eb ** 2)))
+            res["collapse"].append({"ratio": ratio, "reading": str(reading),
+                                    "mu_d": [float(a["mu_d"]), float(b["mu_d"])],
+                                    "mean_abs_dphi": float(np.mean(np.abs(dphi))), "chi2_per_point": chi2,
+                                    "points": int(ok.sum())})
+    return res
+
+
+def plot_study(ds: xr.Dataset) -> Any:
+    """One panel per reading: phi against <r> t for every case, bands of +- one standard error (a Figure)."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    which = [str(r) for r in ds["reading"].values]
+    fig = Figure(figsize=(3.6 * len(which), 4.4), layout="constrained")
+    axes = fig.subplots(1, len(which), sharey=True, squeeze=False)[0]
+    ratios = sorted(set(ds["ratio"].values.tolist()))
+    colors = dict(zip(ratios, ("tab:blue", "tab:orange", "tab:green", "tab:red"), strict=False))
+    styles = {0.5: "-", 0.4: "--"}
+    titles = {"threshold": "copied at $\\theta_c$ (slidernet)", "after": "copied after the slip",
+              "incline": "exact incline, at $\\theta_c$", "incline_after": "exact incline, after the slip"}
+    t = ds["t"].values
+    pos = t >= 1
+    for ax, reading in zip(axes, which, strict=True):
+        for k in range(ds.sizes["case"]):
+            d = ds.isel(case=k).sel(reading=reading)
+            c = colors[float(d["ratio"])]
+            x, y, e = d["rt"].values[pos], d["phi"].values[pos], d["phi_sem"].values[pos]
+            ls = styles.get(round(float(d["mu_d"]), 3), ":")
+            ax.plot(x, y, ls, color=c, lw=1.4)
+            ax.fill_between(x, y - e, y + e, color=c, alpha=0.2, lw=0)
+        ax.axhline(0.0, color="0.5", lw=0.7)
+        ax.set_xscale("log")
+        ax.set_title(titles.get(reading, reading), fontsize=10)
+        ax.set_xlabel(r"$\langle r\rangle t$")
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel(r"$(\mu_s^\mathrm{eff} - \bar\mu_s)/\sigma_\mu$")
+    handles = [Line2D([], [], color=colors[r], lw=3, label=rf"$\sigma_\mu/(\bar\mu_s-\mu_d)={r:g}$")
+               for r in ratios]
+    handles += [Line2D([], [], color="0.3", ls=ls, label=rf"$\mu_d={m:g}$") for m, ls in styles.items()]
+    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), fontsize=8)
+    fig.suptitle(rf"The tilt test under four readings: $\bar\mu_s = {MU_S_MEAN}$, $\tilde N = 10^{{-7}}$, "
+                 rf"$\sigma_\theta = 10^{{-6}}$, {ds.attrs['realizations']} realizations, bands $\pm$ s.e.",
+                 fontsize=10)
+    return fig
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m slidernet.validation.tilt_readings --out DIR``: the study, its figure and its claims."""
+    import argparse
+    import json
+    from pathlib import Path
+
+    from slidernet.io.netcdf import atomic_output, save_figure, write_netcdf
+
+    p = argparse.ArgumentParser(prog="python -m slidernet.validation.tilt_readings",
+                                description=__doc__.split("\n")[0])
+    p.add_argument("--out", required=True, help="folder for mueff_readings.nc, .png and .json")
+    p.add_argument("--steps", type=int, default=100_000, help="thermal steps tau_th (default 1e5, the paper's)")
+    p.add_argument("--realizations", type=int, default=20, help="realizations per case (default 20)")
+    p.add_argument("--seed", type=int, default=300)
+    p.add_argument("--no-progress", action="store_true")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    ds = study(args.steps, args.realizations, args.seed, progress=not args.no_progress)
+    write_netcdf(ds, out / "mueff_readings.nc")
+    save_figure(plot_study(ds), out / "mueff_readings.png", dpi=120)
+    with atomic_output(out / "mueff_readings.json") as tmp:
+        tmp.write_text(json.dumps(claims(ds), indent=1))
+    print(out / "mueff_readings.png")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
