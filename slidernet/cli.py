@@ -4,12 +4,16 @@
                                           writes DIR/result.nc, checkpointing under DIR/checkpoint
 ``slidernet sweep CONFIG.toml --set KEY=V1,V2 ... --out DIR``
                                           a grid of runs, one dataset with the swept dimensions
+``slidernet plot RESULT.nc [--out PATH] [--show]``
+                                          the standard panels of a result (RESULT.png beside it)
 ``slidernet paper [--quick] --out DIR``   reproduces the paper's four figures
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
 ``slidernet plugins``                     lists the registered plugins, where they come from
 ``slidernet units --material steel --size 0.1 --delta-T 0.01``
                                           Ntilde, sigma_theta and tau_th of a physical setup
+
+``python -m slidernet ...`` runs the same command.
 """
 
 from __future__ import annotations
@@ -55,7 +59,21 @@ def _parser() -> argparse.ArgumentParser:
     _progress_flag(sw)
     _execution_flags(sw)
 
-    pp = sub.add_parser("paper", help="reproduce the four figures of Geminard & Bertin (2010)")
+    pl = sub.add_parser(
+        "plot", help="draw the standard panels of a result: n, mu_max, <x_G^2>, mu_eff against t, with the "
+                     "paper's laws; a network's slip map and mu_s field",
+        description="Reads a result of `slidernet run` and writes RESULT.png beside it (or --out PATH): "
+                    "ensemble means +- one standard error against t, the closed forms of the two-slider "
+                    "model where they apply, and for a network its slip map and mu_s field (realization 0).",
+    )
+    pl.add_argument("result", type=Path, help="a result file (DIR/result.nc of slidernet run)")
+    pl.add_argument("--out", type=Path, help="the picture's path; its suffix picks the format (.png, .pdf, "
+                                             ".svg); a folder gets RESULT.png (default: RESULT.png beside RESULT)")
+    pl.add_argument("--show", action="store_true",
+                    help="show the figure in a window instead of writing it (with --out: both)")
+
+    pp = sub.add_parser("paper", help="reproduce the four figures of Geminard & Bertin (2010); a full run "
+                                      "takes TODO-NUMBERS (time and memory of a full run, measured)")
     pp.add_argument("--out", type=Path, required=True, help="output directory")
     pp.add_argument("--quick", action="store_true", help="small preset (under 2 minutes)")
     _progress_flag(pp)
@@ -141,6 +159,44 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from slidernet.analysis.plots import plot_result
+    from slidernet.errors import ConfigError
+
+    out = args.out
+    if out is None and not args.show:
+        out = args.result.with_suffix(".png")
+    elif out is not None and out.is_dir():
+        out = out / args.result.with_suffix(".png").name
+    if out is not None and out.resolve() == args.result.resolve():
+        raise ConfigError(f"The picture would replace the result file {str(args.result)!r}; choose another --out.")
+    figure = None
+    if args.show:
+        import matplotlib.pyplot as plt
+
+        backend = plt.get_backend()
+        if backend.lower() in _non_interactive_backends():
+            raise ConfigError(f"--show needs a window, and matplotlib's backend {backend!r} cannot open one "
+                              "(no display?); write a file instead (--out PATH), or set MPLBACKEND.")
+        figure = plt.figure()
+    plot_result(args.result, out, figure=figure)
+    if out is not None:
+        print(f"wrote {out}")
+    if args.show:
+        plt.show()
+    return 0
+
+
+def _non_interactive_backends() -> list[str]:
+    try:
+        from matplotlib.backends import BackendFilter, backend_registry
+    except ImportError:  # matplotlib < 3.9
+        from matplotlib.rcsetup import non_interactive_bk
+
+        return [name.lower() for name in non_interactive_bk]
+    return backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
+
+
 def _cmd_paper(args: argparse.Namespace) -> int:
     from slidernet.paper.reproduction import reproduce
 
@@ -205,7 +261,7 @@ def _cmd_units(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``slidernet`` command; returns the exit status."""
     args = _parser().parse_args(argv)
-    commands = {"run": _cmd_run, "paper": _cmd_paper, "bench": _cmd_bench, "sweep": _cmd_sweep,
+    commands = {"run": _cmd_run, "plot": _cmd_plot, "paper": _cmd_paper, "bench": _cmd_bench, "sweep": _cmd_sweep,
                 "plugins": _cmd_plugins,
                 "units": _cmd_units}
     try:

@@ -1,4 +1,9 @@
-"""Pictures of per-node fields on a network: where the sliders slipped, and their thresholds.
+"""Pictures of a result: its standard panels, and the per-node fields of a network.
+
+:func:`plot_result` draws what a user looks at first (``slidernet plot``):
+n, mu_max, <x_G^2> and mu_eff against t, with the paper's closed forms of
+:mod:`slidernet.analysis.theory` where they apply (:func:`theory_overlays`),
+and for a network its slip map and mu_s field.
 
 A result of a network scene (kernel ``csr`` in 1D, ``vec`` in 2D) holds two
 per-node variables, dims ``(realization, node)``:
@@ -29,26 +34,31 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import xarray as xr
+from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PathCollection
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from slidernet.errors import ConfigError
-from slidernet.io import save_figure
+from slidernet.analysis import theory
+from slidernet.errors import ConfigError, SlidernetError
+from slidernet.io import read_result, result_config, save_figure
 
 if TYPE_CHECKING:
-    import xarray as xr
     from matplotlib.axes import Axes
 
+    from slidernet.config import Config
     from slidernet.model.network import Network
 
-__all__ = ["EDGE_LIMIT", "mu_s_field", "network_of", "node_field", "save_network_pictures", "slip_map"]
+__all__ = ["EDGE_LIMIT", "Overlay", "mu_s_field", "network_of", "node_field", "plot_result",
+           "save_network_pictures", "slip_map", "theory_overlays"]
 
 #: Springs are drawn only below this many edges: above it they would hide the
 #: nodes at any figure size and cost more to draw than the nodes themselves.
@@ -218,7 +228,6 @@ def network_of(ds: xr.Dataset) -> Network:
         The scene's network, positions in l0, shape (N, d).
     """
     from slidernet.config import load_config
-    from slidernet.io import result_config
     from slidernet.solver import build_network
 
     return build_network(load_config(result_config(ds)))
@@ -241,19 +250,22 @@ def _node_values(ds: xr.Dataset, name: str, what: str, realization: int) -> np.n
     return np.asarray(ds[name].isel(realization=int(realization)).values)
 
 
-def _scene_title(ds: xr.Dataset, realization: int) -> str:
-    from slidernet.io import result_config
-
-    cfg = result_config(ds)
+def _geometry(cfg: dict[str, Any]) -> str:
+    """The network of a resolved configuration (dict) in a few words: "square 6 x 6", "chain, n = 10"."""
     net = cfg.get("network", {})
     kind = net.get("kind", "?")
     if net.get("shape") is not None:
-        geometry = f"{kind} {' x '.join(str(s) for s in net['shape'])}"
-    elif kind == "graph":
-        geometry = f"graph {Path(str(net.get('path'))).name}"
-    else:
-        geometry = f"{kind}, n = {net.get('n')}"
-    return (f"{geometry}, {cfg.get('steps')} steps of " r"$\tau_\mathrm{th}$, "
+        return f"{kind} {' x '.join(str(s) for s in net['shape'])}"
+    if kind == "graph":
+        return f"graph {Path(str(net.get('path'))).name}"
+    if kind == "two_slider":
+        return "two sliders"
+    return f"{kind}, n = {net.get('n')}"
+
+
+def _scene_title(ds: xr.Dataset, realization: int) -> str:
+    cfg = result_config(ds)
+    return (f"{_geometry(cfg)}, {cfg.get('steps')} steps of " r"$\tau_\mathrm{th}$, "
             f"realization {realization} of {ds.sizes['realization']}")
 
 
@@ -389,3 +401,388 @@ def save_network_pictures(ds: xr.Dataset, out_dir: str | os.PathLike[str], *, dp
         fig = draw(ds, 0, network=net)
         paths[name] = save_figure(fig, out / f"{name}.png", dpi=dpi)
     return paths
+
+
+# ---------------------------------------------------------------------------
+# the standard panels of a result
+
+
+@dataclass(frozen=True)
+class Overlay:
+    """One closed form of :func:`theory_overlays`: its values at the recorded times, or why there are none.
+
+    Attributes
+    ----------
+    name : str
+        Short name, e.g. ``"eq. (slope)"``.
+    label : str
+        Legend text when drawn (matplotlib mathtext).
+    values : numpy.ndarray or None
+        The prediction at every recorded time, shape (T,), in the units of
+        the variable it is drawn over; None where the law does not apply.
+    reason : str
+        Why ``values`` is None; empty otherwise.
+    """
+
+    name: str
+    label: str
+    values: np.ndarray | None = None
+    reason: str = ""
+
+    @property
+    def legend(self) -> str:
+        """The legend entry: the label, or the name and why it is not drawn."""
+        return self.label if self.values is not None else f"{self.name}: not drawn ({self.reason})"
+
+
+def _is_two_slider(cfg: Config) -> bool:
+    """True for the paper's scene (reading a graph file only when its size is unknown)."""
+    from slidernet.config import build_network
+
+    return cfg.network.size() in (2, None) and build_network(cfg).is_two_slider()
+
+
+def theory_overlays(ds: xr.Dataset, config: Config | None = None) -> dict[str, Overlay]:
+    r"""The paper's closed forms for a result, at its recorded times.
+
+    The laws of :mod:`slidernet.analysis.theory` describe the paper's two
+    sliders; for any other network every overlay is None. Where they apply:
+
+    ``"n"``
+        eq. ``slope``, n = <r> t with <r> from
+        :func:`~slidernet.analysis.theory.mean_rearrangements` (Ntilde,
+        sigma_theta, mu_d and the mean of p(mu_s) as the model draws it,
+        i.e. conditioned on mu_s > mu_d); needs the ``gaussian_steps``
+        driver, and <r> > 0 (sigma_theta > mu_d Ntilde).
+    ``"mu_max_exact"``
+        the exact mean of the largest of n + 2 draws at the measured mean
+        n(t) (:func:`~slidernet.analysis.theory.mu_max_moments`), for any law.
+    ``"mu_max_leading"``
+        eq. ``mumaxth``, mean mu_s + sigma_mu sqrt(2 ln(<r> t)) with <r>
+        measured (``r_mean``); a Gaussian p(mu_s) only.
+    ``"x_G2"``
+        the order-of-magnitude law sigma_theta^2 l0^2 ln(<r> t)
+        (:func:`~slidernet.analysis.theory.msd`), <r> measured; needs the
+        ``gaussian_steps`` driver.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`slidernet.run`: ``t``, ``n_mean`` and ``r_mean``,
+        and the resolved configuration in ``ds.attrs["config"]``.
+    config : Config, optional
+        The result's configuration, to skip rebuilding it from the attributes.
+
+    Returns
+    -------
+    dict of str to Overlay
+        Keys ``"n"``, ``"mu_max_exact"``, ``"mu_max_leading"``, ``"x_G2"``;
+        values of shape (T,) in the units of n, mu_max and <x_G^2> (l0^2).
+
+    Examples
+    --------
+    >>> import slidernet
+    >>> ds = slidernet.run({"seed": 1, "realizations": 2, "steps": 100,
+    ...                     "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...                     "friction": {"mu_d": 0.5,
+    ...                                  "static": {"name": "uniform", "low": 0.55, "high": 0.65}},
+    ...                     "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}})
+    >>> overlays = theory_overlays(ds)
+    >>> overlays["mu_max_exact"].values.shape == ds["t"].shape
+    True
+    >>> overlays["mu_max_leading"].legend
+    'eq. (mumaxth): not drawn (Gaussian p(mu_s) only)'
+    """
+    from slidernet.config import load_config
+
+    cfg = config if config is not None else load_config(result_config(ds))
+    t = ds["t"].values.astype(float)
+    r_measured = float(ds["r_mean"]) if "r_mean" in ds else None
+    static = cfg.friction.static
+    overlays = {
+        "n": Overlay("eq. (slope)", ""),
+        "mu_max_exact": Overlay("exact mean of the max of n + 2 draws",
+                                r"exact: $E[\max$ of $n+2$ draws$]$ at the measured $\bar n(t)$"),
+        "mu_max_leading": Overlay("eq. (mumaxth)", r"eq. (mumaxth): $\bar\mu_s + \sigma_\mu"
+                                                   r"\sqrt{2\ln(\langle r\rangle t/\tau_\mathrm{th})}$, "
+                                                   r"$\langle r\rangle$ measured"),
+        "x_G2": Overlay("law of <x_G^2>", r"law: $\sigma_\theta^2 l_0^2\ln(\langle r\rangle t/\tau_\mathrm{th})$,"
+                                          " order of magnitude"),
+    }
+
+    def skip(key: str, reason: str) -> None:
+        overlays[key] = Overlay(overlays[key].name, overlays[key].label, None, reason)
+
+    def draw(key: str, values: np.ndarray, label: str | None = None) -> None:
+        o = overlays[key]
+        overlays[key] = Overlay(o.name, label or o.label, np.broadcast_to(values, t.shape).astype(float))
+
+    if not _is_two_slider(cfg):
+        for key in overlays:
+            skip(key, "two sliders only")
+        return overlays
+    gaussian_steps = cfg.driver.name == "gaussian_steps"
+    sigma_theta = float(cfg.driver.params["sigma_theta"]) if gaussian_steps else None
+    mu_d = cfg.friction.mu_d
+    dist = cfg.distribution()
+
+    if not gaussian_steps:
+        skip("n", "gaussian_steps driver only")
+    else:
+        try:
+            r_slope = float(theory.mean_rearrangements(sigma_theta, cfg.network.Ntilde, mu_d,
+                                                       float(dist.mean_max(1))))
+        except SlidernetError as exc:
+            skip("n", str(exc))
+        else:
+            if r_slope > 0:
+                draw("n", r_slope * t, r"eq. (slope): $n = \langle r\rangle t/\tau_\mathrm{th}$, "
+                                       rf"$\langle r\rangle = {r_slope:.3g}$")
+            else:
+                skip("n", rf"$\langle r\rangle = {r_slope:.3g} \leq 0$: $\sigma_\theta \leq \mu_d\tilde N$")
+
+    if "n_mean" in ds:
+        try:
+            draw("mu_max_exact", theory.mu_max_moments(dist, ds["n_mean"].values)[0])
+        except SlidernetError as exc:
+            skip("mu_max_exact", str(exc))
+    else:
+        skip("mu_max_exact", "needs n")
+
+    n_typical = None if r_measured is None else r_measured * t
+    if static.name != "gaussian":
+        skip("mu_max_leading", "Gaussian p(mu_s) only")
+    elif n_typical is None:
+        skip("mu_max_leading", "needs n")
+    else:
+        draw("mu_max_leading", theory.mu_max_leading(float(static.params["mean"]), float(static.params["std"]),
+                                                     n_typical))
+
+    if not gaussian_steps:
+        skip("x_G2", "gaussian_steps driver only")
+    elif n_typical is None:
+        skip("x_G2", "needs n")
+    else:
+        draw("x_G2", theory.msd(sigma_theta, n_typical))
+    return overlays
+
+
+#: The time panels of :func:`plot_result`, in their order on the grid: the
+#: variable drawn (``<name>_mean`` and ``<name>_sem`` of the result), the
+#: observable that records it, and the y label.
+TIME_PANELS = (
+    ("n", "n", r"$n$ (rearrangements since $t = 0$)"),
+    ("mu_max", "mu_max", r"$\mu_\mathrm{max}$ (largest threshold $\mu_s$)"),
+    ("x_G2", "x_G", r"$\langle x_G^2\rangle$ ($l_0^2$)"),
+    ("mu_eff", "mu_eff", r"$\mu_\mathrm{eff}$ (virtual tilt test)"),
+)
+
+
+def _read(path: Path) -> xr.Dataset:
+    """A result file read into memory, or a ConfigError that names the file and what is wrong."""
+    if not path.exists():
+        raise ConfigError(f"The result file {str(path)!r} does not exist.")
+    if not path.is_file():
+        raise ConfigError(f"The result file {str(path)!r} is not a file (a result is the result.nc of "
+                          "`slidernet run`).")
+    try:
+        return read_result(path)
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"The file {str(path)!r} is not a readable netCDF file: "
+                          f"{getattr(exc, 'strerror', None) or exc}.") from None
+
+
+def _check_result(ds: xr.Dataset, source: str) -> None:
+    """Refuse a dataset that is not one run of slidernet (no n over (realization, t))."""
+    if "t" not in ds.coords or "n" not in ds.data_vars or "n_mean" not in ds.data_vars:
+        missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
+                                            ("n_mean", "n_mean" in ds.data_vars)) if not there]
+        has = ", ".join(sorted(map(str, ds.variables))) or "nothing"
+        raise ConfigError(
+            f"{source} is not a result of slidernet run: it has no {' and no '.join(map(repr, missing))} "
+            f"(the time t in tau_th, the rearrangements n over (realization, t) and their ensemble mean). "
+            f"It holds: {has}."
+        )
+    if ds["n"].dims != ("realization", "t"):
+        extra = [d for d in ds["n"].dims if d not in ("realization", "t")]
+        raise ConfigError(
+            f"{source} holds more than one run: its 'n' has dims {ds['n'].dims}, with {extra} besides "
+            "(realization, t), as a sweep has. Plot one point: select it, e.g. ds.isel("
+            f"{extra[0]}=0), and pass that dataset to slidernet.analysis.plots.plot_result."
+        )
+
+
+def _check_format(path: Path) -> None:
+    fmt = path.suffix.lstrip(".").lower()
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if fmt and fmt not in formats:
+        raise ConfigError(f"The picture's file {str(path)!r} has the suffix {path.suffix!r}, which matplotlib "
+                          f"cannot write. Use one of: {', '.join('.' + f for f in sorted(formats))}.")
+
+
+def _summary(cfg: dict[str, Any], ds: xr.Dataset) -> str:
+    """Two lines on the run: scene, size, seed; then the parameters of the model."""
+
+    def plugin(spec: dict[str, Any]) -> str:
+        params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                           for k, v in spec.items() if k != "name")
+        return f"{spec.get('name')}({params})"
+
+    return (f"{_geometry(cfg)}, {ds.sizes['realization']} realizations of {cfg.get('steps')} "
+            rf"$\tau_\mathrm{{th}}$, seed {ds.attrs.get('seed', cfg.get('seed'))}, "
+            f"kernel {ds.attrs.get('kernel', '?')}\n"
+            rf"$\tilde N$ = {cfg['network']['Ntilde']:g}, $\mu_d$ = {cfg['friction']['mu_d']:g}, "
+            rf"$p(\mu_s)$ = {plugin(cfg['friction']['static'])}, driver {plugin(cfg['driver'])}")
+
+
+def _time_panel(ax: Axes, ds: xr.Dataset, name: str, observable: str, ylabel: str,
+                overlays: list[Overlay], log_t: bool) -> None:
+    """Ensemble mean +- one standard error of ``name`` against t, with its overlays; a note if absent."""
+    if f"{name}_mean" not in ds and name not in ds:
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, f"{ylabel}\nnot recorded in this result:\nadd \"{observable}\" to 'observables'",
+                transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.4")
+        return
+    t = ds["t"].values
+    shown = t > 0 if log_t else np.ones(t.shape, bool)
+    mean = ds[f"{name}_mean" if f"{name}_mean" in ds else name].values.astype(float)
+    sem_name = f"{name}_sem"
+    sem = ds[sem_name].values.astype(float) if sem_name in ds else np.full(mean.shape, np.nan)
+    R = ds.sizes["realization"]
+    pooled = name == "mu_eff"  # one pooled ratio over every tilt test, not a mean of realizations
+    what = "pooled over the tilt tests" if pooled else f"mean over {R} realization{'s' * (R > 1)}"
+    band = r" $\pm$ s.e." if np.isfinite(sem[shown]).any() else ""
+    ok = shown & np.isfinite(mean)
+    ax.fill_between(t[ok], (mean - sem)[ok], (mean + sem)[ok], color="C0", alpha=0.3, lw=0)
+    ax.plot(t[ok], mean[ok], "-", marker="o" if ok.sum() <= 200 else None, ms=2.5, color="C0",
+            label=what + band)
+    for o in overlays:
+        if o.values is None:
+            ax.plot([], [], ls="none", label=o.legend)
+        else:
+            ax.plot(t[shown], o.values[shown], "--" if "eq." in o.name or "law" in o.name else "-",
+                    color="k", lw=1.0, label=o.legend)
+    if pooled and log_t and t[0] == 0 and np.isfinite(mean[0]):
+        ax.axhline(mean[0], color="0.5", ls=":", lw=1.0,
+                   label=rf"$t = 0$ (fresh system): $\mu_\mathrm{{eff}}$ = {mean[0]:.4g}")
+    if name == "n" and log_t and (mean[ok] > 0).any():
+        ax.set_yscale("log")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="best")
+
+
+def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.PathLike[str] | None = None, *,
+                figure: Figure | None = None, dpi: int = DPI) -> Figure:
+    r"""The standard panels of a result: what to look at before reading the numbers.
+
+    Four panels against t (tau_th; a logarithmic axis over t > 0): the
+    number of rearrangements n, the largest threshold mu_max, the mean
+    square displacement <x_G^2> (each an ensemble mean with a band of
+    +- one standard error over the realizations) and mu_eff of the virtual
+    tilt test (pooled over the tests, with its standard error). The closed
+    forms of :func:`theory_overlays` are drawn over them where they apply,
+    and the legend says why one is not. A panel whose variable was not
+    recorded says which observable to add. A network's result gets two more
+    panels: its slip map (:func:`slip_map`) and mu_s field
+    (:func:`mu_s_field`) of realization 0.
+
+    Parameters
+    ----------
+    result : xarray.Dataset or path-like
+        A result of :func:`slidernet.run`, or the path of a result file
+        (``result.nc`` of ``slidernet run``).
+    path : path-like, optional
+        Where to write the figure, atomically (a temporary file, then a
+        rename); its suffix picks the format (``.png``, ``.pdf``, ``.svg``,
+        ...). None: write nothing.
+    figure : matplotlib.figure.Figure, optional
+        An empty figure to draw in (e.g. ``pyplot.figure()``, to show it in
+        a window); its size and layout are set here. Default: a new Agg
+        figure, outside pyplot.
+    dpi : int
+        Resolution of a raster file, in dots per inch.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Its first four axes are the time panels (n, mu_max, <x_G^2>, mu_eff),
+        in that order; a network's slip map and mu_s field follow (each with
+        its colorbar in 2D).
+
+    Raises
+    ------
+    ConfigError
+        Before anything is drawn or written: the file is missing or not
+        netCDF; the dataset has no ``t``, ``n`` or ``n_mean`` (not a result
+        of ``slidernet run``) or holds several runs (a sweep); ``path`` has a
+        suffix matplotlib cannot write.
+
+    Examples
+    --------
+    >>> import slidernet
+    >>> ds = slidernet.run({"seed": 1, "realizations": 2, "steps": 100,
+    ...                     "observables": ["n", "mu_max", "x_G", "mu_eff"],
+    ...                     "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...                     "friction": {"mu_d": 0.5,
+    ...                                  "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    ...                     "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}})
+    >>> fig = plot_result(ds)
+    >>> [ax.get_ylabel().split(" (")[0] for ax in fig.axes]
+    ['$n$', '$\\mu_\\mathrm{max}$', '$\\langle x_G^2\\rangle$', '$\\mu_\\mathrm{eff}$']
+    >>> fig.axes[1].get_legend().get_texts()[1].get_text().startswith("exact")
+    True
+    """
+    from slidernet.config import build_network, load_config
+
+    if isinstance(result, xr.Dataset):
+        ds, source, name = result, "The dataset", None
+    else:
+        file = Path(result)
+        ds, source, name = _read(file), f"The file {str(file)!r}", file.name
+    _check_result(ds, source)
+    if path is not None:
+        _check_format(Path(path))
+    cfg_dict = result_config(ds) if "config" in ds.attrs else None
+    cfg = load_config(cfg_dict) if cfg_dict is not None else None
+    if cfg is None:
+        overlays = {key: Overlay(key, "", None, "no configuration in the result") for key in
+                    ("n", "mu_max_exact", "mu_max_leading", "x_G2")}
+    else:
+        overlays = theory_overlays(ds, cfg)
+    panel_overlays = {"n": [overlays["n"]], "mu_max": [overlays["mu_max_exact"], overlays["mu_max_leading"]],
+                      "x_G2": [overlays["x_G2"]], "mu_eff": []}
+    maps = cfg is not None and "node_slips" in ds and "mu_s" in ds
+    net = build_network(cfg) if maps else None
+
+    fig = figure if figure is not None else Figure()
+    if figure is None:
+        FigureCanvasAgg(fig)
+    two_d = net is not None and net.dim == 2
+    fig.set_size_inches(11.0, 12.5 if two_d else (10.5 if maps else 7.5))
+    # The 2D maps size their markers for their axes when drawn: no layout engine may move them later.
+    if two_d:
+        grid = fig.add_gridspec(3, 2, height_ratios=(1.0, 1.0, 1.5), left=0.08, right=0.95, bottom=0.04,
+                                top=0.93, hspace=0.32, wspace=0.25)
+    else:
+        fig.set_layout_engine("constrained")
+        grid = fig.add_gridspec(3 if maps else 2, 2)
+    t = ds["t"].values
+    log_t = bool((t > 0).any())
+    first = None
+    for k, (var, observable, ylabel) in enumerate(TIME_PANELS):
+        ax = fig.add_subplot(grid[k // 2, k % 2], sharex=first)
+        first = first or ax
+        _time_panel(ax, ds, var, observable, ylabel, panel_overlays[var], log_t)
+        if k >= 2:
+            ax.set_xlabel(r"$t/\tau_\mathrm{th}$ (dimensionless time)")
+    if log_t:
+        first.set_xscale("log")
+    if maps:
+        slip_map(ds, 0, ax=fig.add_subplot(grid[2, 0]), network=net)
+        mu_s_field(ds, 0, ax=fig.add_subplot(grid[2, 1]), network=net)
+    heading = name or ds.attrs.get("title", "slidernet result")
+    fig.suptitle(heading if cfg_dict is None else f"{heading}: {_summary(cfg_dict, ds)}", fontsize=10)
+    if path is not None:
+        save_figure(fig, path, dpi=dpi)
+    return fig
