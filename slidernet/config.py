@@ -106,8 +106,8 @@ class NetworkConfig(_Strict):
     k: PositiveFloat | None = Field(
         None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0) (None: 1).")
     kappa: Annotated[float, Field(allow_inf_nan=False)] | None = Field(
-        None, description="Dilation coefficient of every spring: rest length |X_j - X_i| (1 + kappa theta) "
-                          "(None: 1).")
+        None, description="Dilation coefficient of every spring: its rest length is its length at theta = 0 "
+                          "times (1 + kappa theta) (None: 1).")
     normal_load: PositiveFloat | None = Field(
         None, description="Normal load of every slider, in units of N (None: 1).")
     f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = Field(
@@ -364,7 +364,8 @@ class Config(_Strict):
         20, description="Recorded times per decade of t with record = 'log'.")
     observables: list[Observable] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"],
-        description="Variables to record (docs/model.md section 3); the network kernels always add their own.",
+        description="Variables to record (default ['n', 'mu_max', 'x_G']; docs/model.md section 3); the "
+                    "network kernels always add their own.",
     )
     mu_eff_at: Literal["auto", "rearrangements", "records"] = Field(
         "auto", description="When the virtual tilt test of 'mu_eff' is made (above).")
