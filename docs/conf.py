@@ -99,8 +99,8 @@ sphinx_gallery_conf = {
     "within_subsection_order": "FileNameSortKey",
     # Fully qualified names, not functions, so that Sphinx can cache the configuration.
     "reset_argv": "slidernet_gallery.reset_argv",
-    "image_scrapers": ("slidernet_gallery.png_scraper",),
-    "reset_modules": (),
+    # pyplot figures (none so far) and the PNG files an example writes into its --out folder.
+    "image_scrapers": ("matplotlib", "slidernet_gallery.png_scraper"),
     "download_all_examples": False,
     "remove_config_comments": True,
     "show_memory": False,
