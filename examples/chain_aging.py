@@ -1,4 +1,7 @@
-"""Aging of the strongest threshold in chains of 2, 4 and 8 sliders (docs/model.md sections 2 and 4).
+"""Aging of the strongest threshold in chains of 2, 4 and 8 sliders
+================================================================
+
+The model: sections 2 and 4 of :doc:`/model` (``docs/model.md``).
 
 Each chain (free ends, kind ``chain``) is cycled in temperature with the
 driver ``gaussian_steps``. The figure shows the ensemble mean of mu_max
@@ -204,7 +207,7 @@ def plot(ds: xr.Dataset, path: Path) -> Path:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--out", type=Path, default=Path("chain_out"), help="output folder (default chain_out)")
     parser.add_argument("--quick", action="store_true", help="short runs (seconds)")
     parser.add_argument("--steps", type=int, help="thermal steps per realization (overrides the preset)")
@@ -224,5 +227,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+# %%
+# Running the example
+# -------------------
+#
+# The command line: ``main`` parses the options above. The documentation's
+# gallery runs this script with ``--quick`` and a temporary ``--out`` folder
+# (``docs/_ext/slidernet_gallery.py``) and shows the PNG files it writes.
+
 if __name__ == "__main__":
-    raise SystemExit(main())
+    status = main()
+    if status:  # sphinx-gallery runs the script inside Sphinx: exit only on failure
+        raise SystemExit(status)

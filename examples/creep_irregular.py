@@ -1,4 +1,7 @@
-"""Creep of an irregular network under a constant load and thermal cycling (docs/model.md section 2).
+"""Creep of an irregular network under a constant load and thermal cycling
+=======================================================================
+
+The model: section 2 of :doc:`/model` (``docs/model.md``).
 
 An irregular network (``n`` random points joined by their Delaunay
 triangulation, a fixed network seed) carries the same tangential force
@@ -293,7 +296,7 @@ def plot(points: Sequence[Point], preset: Preset, path: Path) -> Path:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--out", type=Path, default=Path("creep_out"), help="output folder (default creep_out)")
     parser.add_argument("--quick", action="store_true", help="a small network and short runs (seconds)")
     parser.add_argument("--n", type=int, help="number of sliders (overrides the preset)")
@@ -315,5 +318,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+# %%
+# Running the example
+# -------------------
+#
+# The command line: ``main`` parses the options above. The documentation's
+# gallery runs this script with ``--quick`` and a temporary ``--out`` folder
+# (``docs/_ext/slidernet_gallery.py``) and shows the PNG files it writes.
+
 if __name__ == "__main__":
-    raise SystemExit(main())
+    status = main()
+    if status:  # sphinx-gallery runs the script inside Sphinx: exit only on failure
+        raise SystemExit(status)

@@ -1,4 +1,7 @@
-"""Aging of mu_max in the three extreme-value classes (two sliders, docs/model.md sections 1 and 4).
+"""Aging of mu_max in the three extreme-value classes (two sliders)
+================================================================
+
+The model: sections 1 and 4 of :doc:`/model` (``docs/model.md``).
 
 In the two-slider system only the weaker slider ever slips, so after n
 rearrangements mu_max is exactly the largest of the n + 2 thresholds drawn
@@ -245,7 +248,7 @@ def plot(ds: xr.Dataset, path: Path, laws: Sequence[Law] = LAWS) -> Path:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--out", type=Path, default=Path("evc_out"), help="output folder (default evc_out)")
     parser.add_argument("--quick", action="store_true", help="short runs (a few seconds)")
     parser.add_argument("--steps", type=int, help="thermal steps per realization (overrides the preset)")
@@ -265,5 +268,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+# %%
+# Running the example
+# -------------------
+#
+# The command line: ``main`` parses the options above. The documentation's
+# gallery runs this script with ``--quick`` and a temporary ``--out`` folder
+# (``docs/_ext/slidernet_gallery.py``) and shows the PNG files it writes.
+
 if __name__ == "__main__":
-    raise SystemExit(main())
+    status = main()
+    if status:  # sphinx-gallery runs the script inside Sphinx: exit only on failure
+        raise SystemExit(status)

@@ -1,12 +1,17 @@
-"""Run the triangular lattice of ``examples/lattice.toml`` and draw where its sliders slipped.
+"""Where the sliders of a triangular lattice slip
+==============================================
+
+Runs the triangular lattice of ``examples/lattice.toml`` (20 x 20 sliders,
+free boundaries, 4 realizations of 200 tau_th) and draws where its sliders
+slipped.
 
 Writes ``result.nc``, ``slip_map.png`` (slips per node, log scale) and
 ``mu_s_field.png`` (thresholds at the end) for realization 0::
 
     python examples/lattice_pictures.py --out out/lattice
 
-Only the boundary feels the dilation directly (docs/model.md section 2), so the
-boundary nodes slip most and the count falls towards the centre.
+Only the boundary feels the dilation directly (section 2 of :doc:`/model`), so
+the boundary nodes slip most and the count falls towards the centre.
 """
 
 from __future__ import annotations
@@ -20,11 +25,14 @@ from slidernet.analysis.plots import save_network_pictures
 from slidernet.config import load_config
 from slidernet.io import write_netcdf
 
-CONFIG = Path(__file__).with_name("lattice.toml")
+try:
+    CONFIG = Path(__file__).with_name("lattice.toml")
+except NameError:  # sphinx-gallery defines no __file__; it runs the script from examples/
+    CONFIG = Path("lattice.toml").resolve()
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--out", type=Path, default=Path("out/lattice"),
                         help="output folder (default out/lattice)")
     parser.add_argument("--config", type=Path, default=CONFIG, help=f"network config (default {CONFIG.name})")
@@ -40,5 +48,15 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+# %%
+# Running the example
+# -------------------
+#
+# The command line: ``main`` parses the options above. The documentation's
+# gallery runs this script with a temporary ``--out`` folder
+# (``docs/_ext/slidernet_gallery.py``) and shows the PNG files it writes.
+
 if __name__ == "__main__":
-    raise SystemExit(main())
+    status = main()
+    if status:  # sphinx-gallery runs the script inside Sphinx: exit only on failure
+        raise SystemExit(status)

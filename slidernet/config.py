@@ -57,7 +57,7 @@ class PluginSpec(BaseModel):
     """A registered plugin by ``name``; every other key is a parameter of its factory."""
 
     model_config = ConfigDict(extra="allow")
-    name: str
+    name: str = Field(description="The name the plugin is registered under (built-in or from an entry point).")
 
     @property
     def params(self) -> dict[str, Any]:
@@ -89,16 +89,30 @@ class NetworkConfig(_Strict):
     along x, ``[fx, fy]`` a 2D force (2D networks only); default 0.
     """
 
-    kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = "two_slider"
-    Ntilde: PositiveFloat
-    n: Annotated[int, Field(ge=2)] | None = None
-    shape: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = None
-    path: str | None = None
-    seed: Annotated[int, Field(ge=0)] | None = None
-    k: PositiveFloat | None = None
-    kappa: Annotated[float, Field(allow_inf_nan=False)] | None = None
-    normal_load: PositiveFloat | None = None
-    f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = None
+    kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = Field(
+        "two_slider", description="The network's geometry; each kind takes its own size keys (above).")
+    Ntilde: PositiveFloat = Field(
+        description="Ntilde = N / (k l0), the one dimensionless number of the model (docs/model.md section 1); "
+                    "may come from [units] instead.")
+    n: Annotated[int, Field(ge=2)] | None = Field(
+        None, description="Number of sliders: kinds 'chain' and 'irregular' (and 2 for 'two_slider').")
+    shape: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = Field(
+        None, description="[rows, cols] of a 'square' or 'triangular' lattice (at least 2 sliders).")
+    path: str | None = Field(
+        None, description="A GraphML or edge-list file of kind 'graph'; relative to the TOML file that names it.")
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="Seed of an 'irregular' network's random points (None: 0); the geometry is the "
+                          "same for every realization, whatever the run's seed.")
+    k: PositiveFloat | None = Field(
+        None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0) (None: 1).")
+    kappa: Annotated[float, Field(allow_inf_nan=False)] | None = Field(
+        None, description="Dilation coefficient of every spring: its rest length is its length at theta = 0 "
+                          "times (1 + kappa theta) (None: 1).")
+    normal_load: PositiveFloat | None = Field(
+        None, description="Normal load of every slider, in units of N (None: 1).")
+    f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = Field(
+        None, description="Constant external tangential force on every slider, in units of N: a number "
+                          "along x, or [fx, fy] (2D networks only); None: 0.")
 
     @model_validator(mode="after")
     def _params_match_kind(self) -> NetworkConfig:
@@ -136,8 +150,10 @@ class NetworkConfig(_Strict):
 class FrictionConfig(_Strict):
     """Dynamic coefficient mu_d and the distribution of static thresholds mu_s."""
 
-    mu_d: PositiveFloat
-    static: PluginSpec
+    mu_d: PositiveFloat = Field(description="Dynamic friction coefficient mu_d (dimensionless).")
+    static: PluginSpec = Field(
+        description="The distribution p(mu_s) of the static thresholds: a registered name and its "
+                    "parameters; conditioned on mu_s > mu_d.")
 
 
 class UnitsConfig(_Strict):
@@ -158,15 +174,18 @@ class UnitsConfig(_Strict):
     both, loads again); otherwise the configuration is refused.
     """
 
-    material: str | None = None
-    rho: PositiveFloat | None = None
-    Y: PositiveFloat | None = None
-    alpha: PositiveFloat | None = None
-    conductivity: PositiveFloat | None = None
-    heat_capacity: PositiveFloat | None = None
-    size: PositiveFloat
-    delta_T: PositiveFloat | None = None
-    g: PositiveFloat = units.G_STANDARD
+    material: str | None = Field(
+        None, description="A preset material: 'steel', 'glass', 'granite' or 'pmma' (explicit values "
+                          "override it).")
+    rho: PositiveFloat | None = Field(None, description="Density of the sliders, in kg/m^3.")
+    Y: PositiveFloat | None = Field(None, description="Young's modulus, in Pa.")
+    alpha: PositiveFloat | None = Field(None, description="Linear thermal expansion coefficient, in 1/K.")
+    conductivity: PositiveFloat | None = Field(None, description="Thermal conductivity, in W/(m K).")
+    heat_capacity: PositiveFloat | None = Field(None, description="Specific heat capacity, in J/(kg K).")
+    size: PositiveFloat = Field(description="Size of a slider, l0, in m.")
+    delta_T: PositiveFloat | None = Field(
+        None, description="Amplitude of the temperature variations, in K: gives sigma_theta = alpha delta_T.")
+    g: PositiveFloat = Field(units.G_STANDARD, description="Acceleration of gravity, in m/s^2.")
 
     @field_validator("material")
     @classmethod
@@ -249,12 +268,19 @@ class SolverConfig(_Strict):
     says it is incomplete; the run itself goes on.
     """
 
-    kernel: Literal["auto", "pair", "csr", "vec"] = "auto"
-    max_avalanche: Annotated[int, Field(ge=1)] = 100_000_000
-    batch: Annotated[int, Field(ge=1)] = 1 << 16
-    recompute_every: Annotated[int, Field(ge=0)] = 10_000_000
-    slip: Literal["straight", "exact"] = "straight"
-    max_events: Annotated[int, Field(ge=1)] = 10_000_000
+    kernel: Literal["auto", "pair", "csr", "vec"] = Field(
+        "auto", description="The compiled kernel: 'auto' picks the one the scene needs.")
+    max_avalanche: Annotated[int, Field(ge=1)] = Field(
+        100_000_000, description="Slips after which an avalanche that has not ended stops the run with an "
+                                 "AvalancheError.")
+    batch: Annotated[int, Field(ge=1)] = Field(
+        1 << 16, description="Random draws that wait in the kernels' buffers; never changes a result.")
+    recompute_every: Annotated[int, Field(ge=0)] = Field(
+        10_000_000, description="Slips between two resets of the forces from the displacements (0: never).")
+    slip: Literal["straight", "exact"] = Field(
+        "straight", description="2D slips: along the force in a straight line, or integrated exactly.")
+    max_events: Annotated[int, Field(ge=1)] = Field(
+        10_000_000, description="Rows of the event catalogue (observable 'events') kept per realization.")
 
 
 _SCHEDULER_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
@@ -275,10 +301,15 @@ class ExecutionConfig(_Strict):
     (a run may resume with other workers).
     """
 
-    workers: Annotated[int, Field(ge=1)] | None = None
-    scheduler: str | None = None
-    checkpoint_every: Annotated[float, Field(gt=0)] = 60.0
-    scheduler_timeout: Annotated[float, Field(gt=0)] = 10.0
+    workers: Annotated[int, Field(ge=1)] | None = Field(
+        None, description="Local processes that run the realizations (None: every core this process may use).")
+    scheduler: str | None = Field(
+        None, description="Address of a Dask scheduler, 'tcp://host:port'; when given, the realizations run "
+                          "on that cluster and 'workers' is ignored.")
+    checkpoint_every: Annotated[float, Field(gt=0)] = Field(
+        60.0, description="Seconds between two saves of the work of a run that has an output directory.")
+    scheduler_timeout: Annotated[float, Field(gt=0)] = Field(
+        10.0, description="Seconds to wait for the Dask scheduler to answer before giving up.")
 
     @field_validator("scheduler")
     @classmethod
@@ -320,21 +351,35 @@ class Config(_Strict):
     temperature amplitude, where they are not given.
     """
 
-    seed: Annotated[int, Field(ge=0)] | None = None
-    realizations: Annotated[int, Field(ge=1)] = 1
-    steps: Annotated[int, Field(ge=1)]
-    record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = "log"
-    log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = 20
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
+                          "(None: fresh OS entropy, stored in the result).")
+    realizations: Annotated[int, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
+    steps: Annotated[int, Field(ge=1)] = Field(
+        description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")
+    record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = Field(
+        "log", description="Recorded times, in tau_th: 'log'-spaced, 'all', or a list of steps; 0 and 'steps' "
+                           "always included.")
+    log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = Field(
+        20, description="Recorded times per decade of t with record = 'log'.")
     observables: list[Observable] = Field(
-        default_factory=lambda: ["n", "mu_max", "x_G"]
+        default_factory=lambda: ["n", "mu_max", "x_G"],
+        description="Variables to record (default ['n', 'mu_max', 'x_G']; docs/model.md section 3); the "
+                    "network kernels always add their own.",
     )
-    mu_eff_at: Literal["auto", "rearrangements", "records"] = "auto"
-    units: UnitsConfig | None = None
-    network: NetworkConfig
-    friction: FrictionConfig
-    driver: PluginSpec
-    solver: SolverConfig = Field(default_factory=SolverConfig)
-    execution: ExecutionConfig = Field(default_factory=ExecutionConfig)
+    mu_eff_at: Literal["auto", "rearrangements", "records"] = Field(
+        "auto", description="When the virtual tilt test of 'mu_eff' is made (above).")
+    units: UnitsConfig | None = Field(
+        None, description="A physical setup that gives network.Ntilde and driver.sigma_theta where they are "
+                          "not given.")
+    network: NetworkConfig = Field(description="The network of sliders and springs.")
+    friction: FrictionConfig = Field(description="mu_d and the distribution of the static thresholds mu_s.")
+    driver: PluginSpec = Field(
+        description="The temperature driver theta(t): a registered name and its parameters.")
+    solver: SolverConfig = Field(default_factory=SolverConfig, description="Choices of the solver.")
+    execution: ExecutionConfig = Field(
+        default_factory=ExecutionConfig,
+        description="Where the realizations run; never changes a result, and not part of a run's identity.")
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)

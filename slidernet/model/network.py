@@ -83,7 +83,7 @@ class Network:
         Thermal expansion of each spring relative to the slider material (default 1).
     rest_length : float or array_like, shape (E,), optional
         Natural length of each spring at theta = 0, in l0, which sets its
-        thermal load k L kappa theta (default: the distance |X_j - X_i|).
+        thermal load k L kappa theta (default: the distance ``|X_j - X_i|``).
         The initial state is at rest whatever it is.
     normal_load : float or array_like, shape (N,)
         Normal loads N_i in units of N (default 1); they also weight x_G.
@@ -194,7 +194,7 @@ class Network:
         return self._unit
 
     def lengths(self) -> np.ndarray:
-        """Distances |X_j - X_i| of every spring's ends, in l0, shape (E,) (read-only)."""
+        """Distances ``|X_j - X_i|`` of every spring's ends, in l0, shape (E,) (read-only)."""
         return self._length
 
     def incidence(self) -> sp.csr_matrix:
