@@ -153,8 +153,8 @@ def test_mean_rearrangements_follow_the_rule_and_eq_slope_approximates_them(rati
     tolerance = 3 * np.hypot(sem, expected_sem)
     assert abs(r - expected) <= tolerance, (r, sem, expected, expected_sem)
     assert tolerance < 0.01 * expected  # precise enough to mean something
-    # Eq. `slope` is the paper's approximation of that expectation: the README
-    # says it is within -2.7 % to +2.2 % of <r> from sigma_theta/Ntilde = 1 to
+    # Eq. `slope` is the paper's approximation of that expectation: the reproduction
+    # report (docs/reproduction.md) says it is within -2.7 % to +2.2 % of <r> from sigma_theta/Ntilde = 1 to
     # 100; checked here against the rule, allowing its 3 standard errors.
     predicted = float(mean_rearrangements(ratio * NTILDE, NTILDE, MU_D, MU_S_MEAN))
     slack = 3 * expected_sem / predicted

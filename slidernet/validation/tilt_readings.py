@@ -355,7 +355,7 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
     cfg["observables"] = sorted(set(cfg.get("observables", ["n", "mu_max"])) | {"mu_eff"})
     model = load_config(cfg)
     scene = Scene.from_config(model)
-    if scene.kernel != "pair":
+    if model.network.kind != "two_slider":
         raise param_error("network.kind", "readings", "'two_slider'", cfg.get("network", {}).get("kind"))
     seeds = realization_seeds(model.seed, model.realizations)
     T = scene.out_steps.size
