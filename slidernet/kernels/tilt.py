@@ -5,32 +5,41 @@ from __future__ import annotations
 from slidernet.kernels.state import DONE, NEED_TILT, TILT_LIMIT, TILT_MAX_ITER, kernel_jit
 
 
-@kernel_jit()
-def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
-    """The appendix's virtual tilt test on a copy of (F, mu1, mu2).
+@kernel_jit(inline="always")
+def flat_onset(F, mu1, mu2):
+    """The slider that starts first on the appendix's substrate, and at which load: (i, f, c).
 
-    ``F`` is F_{1->2}, the spring force on slider 2 in units of N. The
-    redrawn thresholds and uniforms are read from ``draws.tilt_mu`` and
-    ``draws.tilt_u`` at the state's ``tilt_mu_pos`` and ``tilt_u_pos``.
-    Returns the tangential force f at which the whole system slides (mu_eff
-    sample), -1.0 if the draw buffers ran out (read positions are then left
-    untouched), or -2.0 after ``TILT_MAX_ITER`` iterations.
+    Forces are per unit normal load and the spring force F does not change
+    with the tilt, so slider 1 starts at f1 = mu1 + F and slider 2 at
+    f2 = mu2 - F (ties: slider 1). c = 1: the normal load does not change.
+    """
+    f1 = mu1 + F
+    f2 = mu2 - F
+    if f1 <= f2:
+        return 1, f1, 1.0
+    return 2, f2, 1.0
+
+
+@kernel_jit(inline="always")
+def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
+    """The appendix's iteration of the tilt test, for a rule of onset ``onset(F, mu1, mu2) -> (i, f, c)``.
+
+    ``onset`` gives the slider i that starts first, the tangential load f at
+    that moment and c, the normal load there over its value on the flat.
+    The appendix's rules then act on the forces per unit normal load, the
+    spring's being F / c; F is carried in units of the normal load on the
+    flat. With :func:`flat_onset` (c = 1) this is the appendix as written.
+    Returns f at which the pair slides, -1.0 if the draw buffers ran out
+    (read positions left untouched), -2.0 after ``TILT_MAX_ITER`` iterations.
     """
     tilt_mu = draws.tilt_mu
     tilt_u = draws.tilt_u
     p_mu = st.tilt_mu_pos
     p_u = st.tilt_u_pos
     for _ in range(TILT_MAX_ITER):
-        f1 = mu1 + F
-        f2 = mu2 - F
-        if f1 <= f2:  # slider 1 moves first (ties: lowest index)
-            i = 1
-            f = f1
-            bound = mu_d - 0.5 * (mu1 - mu2)
-        else:
-            i = 2
-            f = f2
-            bound = mu_d + 0.5 * (mu1 - mu2)
+        i, f, c = onset(F, mu1, mu2)
+        FN = F / c  # exact for c = 1
+        bound = mu_d - 0.5 * (mu1 - mu2) if i == 1 else mu_d + 0.5 * (mu1 - mu2)
         if f >= bound:  # eq. `stab`: the other slider moves too
             if f > mu_d:
                 st.tilt_mu_pos = p_mu
@@ -44,19 +53,34 @@ def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
             mu2 = tilt_mu[p_mu + 1]
             p_mu += 2
             lo = f - mu1
-            F = lo + ((mu2 - f) - lo) * tilt_u[p_u]
+            FN = lo + ((mu2 - f) - lo) * tilt_u[p_u]
             p_u += 1
         else:
             if p_mu + 1 > tilt_mu.size:
                 return -1.0
             if i == 1:
-                F += 2.0 * (mu1 - mu_d)
+                FN += 2.0 * (mu1 - mu_d)
                 mu1 = tilt_mu[p_mu]
             else:
-                F -= 2.0 * (mu2 - mu_d)
+                FN -= 2.0 * (mu2 - mu_d)
                 mu2 = tilt_mu[p_mu]
             p_mu += 1
+        F = FN * c  # exact for c = 1
     return -2.0
+
+
+@kernel_jit()
+def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
+    """The appendix's virtual tilt test on a copy of (F, mu1, mu2).
+
+    ``F`` is F_{1->2}, the spring force on slider 2 in units of N. The
+    redrawn thresholds and uniforms are read from ``draws.tilt_mu`` and
+    ``draws.tilt_u`` at the state's ``tilt_mu_pos`` and ``tilt_u_pos``.
+    Returns the tangential force f at which the whole system slides (mu_eff
+    sample), -1.0 if the draw buffers ran out (read positions are then left
+    untouched), or -2.0 after ``TILT_MAX_ITER`` iterations.
+    """
+    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, flat_onset)
 
 
 @kernel_jit()

@@ -51,7 +51,7 @@ from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import param_error
 from slidernet.kernels import Draws, new_state
 from slidernet.kernels.state import TILT_MAX_ITER, kernel_jit
-from slidernet.kernels.tilt import tilt_test_pair
+from slidernet.kernels.tilt import tilt_iterations, tilt_test_pair
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver import Scene, horizontal_draws, realization_streams
 
@@ -67,9 +67,29 @@ _TILT_LIMIT = 3
 _BATCH = 1 << 16
 
 
+@kernel_jit(inline="always")
+def incline_onset(F, mu1, mu2):
+    """The slider that starts first on an exact incline: (i, tan(alpha_i), cos(alpha_i)).
+
+    Slider 1 starts at sin(alpha) - mu1 cos(alpha) = F, slider 2 at
+    sin(alpha) - mu2 cos(alpha) = -F (ties: slider 1), F in units of the
+    normal load on the flat.
+    """
+    a1 = math.atan(mu1) + math.asin(F / math.sqrt(1.0 + mu1 * mu1))
+    a2 = math.atan(mu2) - math.asin(F / math.sqrt(1.0 + mu2 * mu2))
+    if a1 <= a2:
+        return 1, math.tan(a1), math.cos(a1)
+    return 2, math.tan(a2), math.cos(a2)
+
+
 @kernel_jit()
 def tilt_test_incline(st, draws, F, mu1, mu2, mu_d):
     """The appendix's tilt test on an exact incline: tan(alpha_c), the tilt at which the pair slides.
+
+    The iteration is the solver's (:func:`slidernet.kernels.tilt.tilt_iterations`)
+    with the onset of :func:`incline_onset`: at the tilt alpha where a slider
+    starts, the appendix's rules act on the forces per unit normal load,
+    f / N = tan(alpha) and F / N = F / cos(alpha).
 
     Parameters
     ----------
@@ -93,49 +113,7 @@ def tilt_test_incline(st, draws, F, mu1, mu2, mu_d):
         tan(alpha_c); -1.0 if the draw buffers ran out, -2.0 after
         ``TILT_MAX_ITER`` iterations.
     """
-    tilt_mu = draws.tilt_mu
-    tilt_u = draws.tilt_u
-    p_mu = st.tilt_mu_pos
-    p_u = st.tilt_u_pos
-    for _ in range(TILT_MAX_ITER):
-        a1 = math.atan(mu1) + math.asin(F / math.sqrt(1.0 + mu1 * mu1))
-        a2 = math.atan(mu2) - math.asin(F / math.sqrt(1.0 + mu2 * mu2))
-        if a1 <= a2:  # slider 1 moves first (ties: lowest index)
-            i = 1
-            alpha = a1
-            bound = mu_d - 0.5 * (mu1 - mu2)
-        else:
-            i = 2
-            alpha = a2
-            bound = mu_d + 0.5 * (mu1 - mu2)
-        f = math.tan(alpha)  # the tangential load per unit normal load at alpha
-        c = math.cos(alpha)
-        FN = F / c  # the spring force per unit normal load at alpha
-        if f >= bound:  # eq. `stab`: the other slider moves too
-            if f > mu_d:
-                st.tilt_mu_pos = p_mu
-                st.tilt_u_pos = p_u
-                return f
-            if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
-                return -1.0
-            mu1 = tilt_mu[p_mu]
-            mu2 = tilt_mu[p_mu + 1]
-            p_mu += 2
-            lo = f - mu1
-            FN = lo + ((mu2 - f) - lo) * tilt_u[p_u]
-            p_u += 1
-        else:
-            if p_mu + 1 > tilt_mu.size:
-                return -1.0
-            if i == 1:
-                FN += 2.0 * (mu1 - mu_d)
-                mu1 = tilt_mu[p_mu]
-            else:
-                FN -= 2.0 * (mu2 - mu_d)
-                mu2 = tilt_mu[p_mu]
-            p_mu += 1
-        F = FN * c
-    return -2.0
+    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, incline_onset)
 
 
 @kernel_jit()
