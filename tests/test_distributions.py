@@ -104,7 +104,7 @@ def randomized_pit(cdf, x: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def test_builtins_are_registered():
-    assert set(BUILTINS) == {"gaussian", "uniform", "weibull", "lognormal", "exponential", "pareto",
+    assert set(BUILTINS) == {"gaussian", "uniform", "constant", "weibull", "lognormal", "exponential", "pareto",
                              "empirical", "scipy"}
     for name, cls in BUILTINS.items():
         assert registry.distributions.get(name) is cls
@@ -632,3 +632,25 @@ def test_a_plugin_that_draws_at_or_below_mu_d_is_stopped_naming_it():
     with pytest.raises(slidernet.PluginError, match=r"The distribution 'liar' returned \d+ values at or below "
                                                     r"mu_d = 0\.5 from sample\(rng, 100\)"):
         d.sample(np.random.default_rng(0), 100)
+
+
+def test_constant_thresholds_through_a_config():
+    """The clean-friction law: every threshold, initial and redrawn, is the value; no draw is made."""
+    cfg = {"seed": 1, "realizations": 2, "steps": 300, "observables": ["n", "mu_max"],
+           "network": {"kind": "chain", "n": 4, "Ntilde": 1e-7},
+           "friction": {"mu_d": 0.5, "static": {"name": "constant", "value": 0.6}},
+           "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}
+    ds = slidernet.run(cfg, progress=False)
+    assert (ds["n"].isel(t=-1) > 0).all()
+    assert (ds["mu_max"] == 0.6).all()
+
+
+@pytest.mark.parametrize("value", [0.5, 0.3], ids=["equal-to-mu_d", "below-mu_d"])
+def test_a_constant_value_at_or_below_mu_d_is_refused(value):
+    cfg = {"steps": 10, "network": {"kind": "two_slider", "Ntilde": 1e-7},
+           "friction": {"mu_d": 0.5, "static": {"name": "constant",
+                                                                                   "value": value}},
+           "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}
+    msg = rf"The 'value' parameter of constant must be > mu_d = 0\.5\. Got {value}"
+    with pytest.raises(ConfigError, match=msg):
+        slidernet.load_config(cfg)

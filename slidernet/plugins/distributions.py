@@ -475,6 +475,77 @@ class Uniform(Distribution):
         return a + (self.high - a) * m_arr / (m_arr + 1.0)
 
 
+class Constant(Distribution):
+    """Every mu_s equals ``value``: clean friction (Blanc, Pugnaloni & Géminard 2011).
+
+    A point mass. No random number is drawn, so a run's other streams are as
+    they would be with any other law. ``value`` must exceed mu_d (the
+    slip 2 (mu_s - mu_d) N / k must move the slider forward).
+
+    Parameters
+    ----------
+    value : float
+        The static coefficient of every slider (dimensionless), finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> d = Constant(value=0.6)
+    >>> d.sample(np.random.default_rng(0), 3), float(d.mean_max(10))
+    (array([0.6, 0.6, 0.6]), 0.6)
+    >>> d.check_mu_d(0.6)
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The 'value' parameter of constant must be > mu_d = 0.6. Got 0.6 instead.
+    """
+
+    name = "constant"
+    example_params: ClassVar[dict[str, Any]] = {"value": 0.6}
+    _mu_d_param = "value"
+
+    def __init__(self, value: float) -> None:
+        self.value = _check_finite(value, "value", "constant")
+
+    def _params(self) -> dict[str, Any]:
+        return {"value": self.value}
+
+    def check_mu_d(self, mu_d: float) -> None:
+        """Refuse ``value <= mu_d`` (a slip would not move the slider)."""
+        if not self.value > float(mu_d):
+            raise param_error("value", self.name, f"> mu_d = {float(mu_d)!r}", self.value)
+
+    def support(self) -> tuple[float, float]:
+        """(value, value)."""
+        return self.value, self.value
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """``size`` copies of ``value``, shape ``(size,)``; ``rng`` is not used."""
+        return np.full(size, self.value)
+
+    def cdf(self, x: ArrayLike) -> np.ndarray:
+        """P(mu_s <= x): 0 below ``value``, 1 from it on."""
+        return (np.asarray(x, dtype=float) >= self.value).astype(float)
+
+    def sf(self, x: ArrayLike) -> np.ndarray:
+        """P(mu_s > x)."""
+        return (np.asarray(x, dtype=float) < self.value).astype(float)
+
+    def ppf(self, u: ArrayLike) -> np.ndarray:
+        """``value`` for every u."""
+        return np.full(np.shape(u), self.value)
+
+    def isf(self, q: ArrayLike) -> np.ndarray:
+        """``value`` for every q."""
+        return np.full(np.shape(q), self.value)
+
+    def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
+        """``value``, whatever m (above ``lower``)."""
+        m_arr = _check_m(m)
+        if not self.value > float(lower):
+            raise param_error("value", self.name, f"> lower = {lower!r}", self.value)
+        return np.full(m_arr.shape, self.value)
+
+
 class Weibull(Distribution):
     """Weibull p(mu_s): mu_s = loc + scale * W, P(W > w) = exp(-w^shape).
 
@@ -1408,5 +1479,5 @@ class TruncatedStream:
 # The built-in distributions, by the name a config uses (``friction.static.name``).
 BUILTINS: dict[str, type] = {
     cls.name: cls
-    for cls in (Gaussian, Uniform, Weibull, Lognormal, Exponential, Pareto, Empirical, ScipyStats)
+    for cls in (Gaussian, Uniform, Constant, Weibull, Lognormal, Exponential, Pareto, Empirical, ScipyStats)
 }
