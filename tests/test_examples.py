@@ -97,3 +97,24 @@ def test_chain_aging_quick(tmp_path):
     # Longer chains need more slips per tau_th to follow the dilation.
     r = ds["r_mean"].values
     assert r[0] < r[1] < r[2]
+
+
+def test_incline_creep_quick(tmp_path):
+    """The --quick preset (seeds fixed in the script): the pair's staircase is the theory's, creep stops below A_c."""
+    import json
+
+    import numpy as np
+
+    example = load_example("incline_creep")
+    assert example.main(["--quick", "--out", str(tmp_path)]) == 0
+    assert_png(tmp_path / "incline_creep.png")
+    assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
+    data = json.loads((tmp_path / "incline_creep.json").read_text())
+    a = data["a"]
+    theory_at_points = np.interp(a["tan_alpha"], a["theory_2"]["tan_alpha"], a["theory_2"]["v"])
+    off_steps = [min(abs(t - s) for s in a["theory_2"]["steps"]) > 0.01 for t in a["tan_alpha"]]
+    np.testing.assert_allclose(np.asarray(a["v"]["2"])[off_steps], theory_at_points[off_steps], atol=1e-9)
+    b = data["b"]
+    below = np.asarray(b["A_over_Ntilde"]) < b["A_c_from_rest"]
+    assert (np.asarray(b["runs"]["2-constant"]["v"])[below] == 0).all()
+    assert (np.asarray(b["runs"]["2-constant"]["v"])[~below] > 0).all()
