@@ -125,10 +125,13 @@ def _creep_variables(ds: Variables, records: list[Record]) -> None:
     counts = np.array([e["time"].size for e in events], np.int64)
     ds["creep_event_count"] = ("realization", counts, {"long_name": "number of creep events", "units": "1"})
     width = int(counts.max())
+    # The scene's constants (the same in every record): the reference slip and the events' threshold.
+    constants = {"reference_slip": float(records[0]["creep_slip"]),
+                 "event_threshold": float(records[0]["creep_threshold"])}
     for name, (long_name, units) in CREEP_EVENT_ATTRS.items():
         var = "creep_waiting_time" if name == "wait" else f"creep_event_{name}"
         ds[var] = (("realization", "creep_event"), _padded([e[name] for e in events], width),
-                   {"long_name": long_name + "; NaN past creep_event_count", "units": units})
+                   {"long_name": long_name + "; NaN past creep_event_count", "units": units, **constants})
 
 
 def realization_variables(records: list[Record], observables: list[str], first_realization: int = 0) -> Variables:

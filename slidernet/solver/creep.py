@@ -134,7 +134,8 @@ def creep_record(events: dict[str, np.ndarray], complete: bool, steps: int, spec
     -------
     dict
         ``cycle_end`` (the times c P, tau_th), ``x_G_cycle``, ``dx_G_cycle``
-        (l0), each of shape (C,) and only with a period;
+        (l0), each of shape (C,) and only with a period; ``creep_slip`` and
+        ``creep_threshold`` (the scene's ell and event threshold, l0);
         ``v_creep`` (l0 / tau_th), ``v_creep_cycle`` (l0 per cycle; NaN
         without a period), ``v_creep_cycles_sem`` (l0 / tau_th), and
         ``creep_events``: a dict of arrays of shape (E,), ``time`` (tau_th),
@@ -157,16 +158,16 @@ def creep_record(events: dict[str, np.ndarray], complete: bool, steps: int, spec
     P = spec.period
     C = whole_cycles(steps, P) if P is not None else 0
     ends = P * np.arange(1, C + 1) if P is not None else np.zeros(0)
+    out: dict[str, Any] = {"creep_slip": np.float64(spec.slip), "creep_threshold": np.float64(spec.threshold)}
     if not complete:
         nothing = np.zeros(0)
-        out: dict[str, Any] = {"v_creep": np.float64(np.nan), "v_creep_cycle": np.float64(np.nan),
-                               "v_creep_cycles_sem": np.float64(np.nan),
-                               "creep_events": {"time": nothing, "dx_G": nothing, "wait": nothing}}
+        out.update(v_creep=np.float64(np.nan), v_creep_cycle=np.float64(np.nan),
+                   v_creep_cycles_sem=np.float64(np.nan),
+                   creep_events={"time": nothing, "dx_G": nothing, "wait": nothing})
         if P is not None:
             out.update(cycle_end=ends, x_G_cycle=np.full(C, np.nan), dx_G_cycle=np.full(C, np.nan))
         return out
     time, dx_G = avalanches(events, spec.weights)
-    out = {}
     t0 = spec.transient
     first = math.ceil(t0 / P * (1.0 - 1e-12)) if P is not None else C  # the first whole cycle after t0
     if P is not None:
