@@ -70,8 +70,8 @@ def reference_slip(mu_s_mean: float, mu_d: float, normal_load: np.ndarray, k: np
 
     Examples
     --------
-    >>> reference_slip(0.6, 0.5, np.ones(2), np.ones(1), 1e-7)  # 2 (0.6 - 0.5) 1e-7
-    2e-08
+    >>> round(reference_slip(0.6, 0.5, np.ones(2), np.ones(1), 1e-7) / 1e-8, 12)  # 2 (0.6 - 0.5) 1e-7 / 1e-8
+    2.0
     """
     return float(2.0 * (mu_s_mean - mu_d) * np.mean(normal_load) * Ntilde / np.mean(k))
 
