@@ -717,7 +717,7 @@ def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -
     """The kernel a scene runs on: the one rule, used by the scene and by the checks of a configuration.
 
     ``auto`` gives ``pair`` (scalars only) for the paper's two sliders unless
-    the event catalogue is asked for (it needs per-node state), and else the
+    the event catalogue is kept (observables "events" and "creep"; it needs per-node state), and else the
     network kernel of the dimension: ``csr`` in 1D, ``vec`` in 2D. A kernel
     named in ``solver.kernel`` is returned as it is (the scene refuses one
     that cannot run its network).
