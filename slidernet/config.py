@@ -31,7 +31,17 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    SerializerFunctionWrapHandler,
+    ValidationError,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from slidernet.errors import ConfigError, SlidernetError
 from slidernet.model import units
@@ -46,7 +56,7 @@ else:  # pragma: no cover
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records", "events")
+OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records", "events", "creep")
 
 
 class _Strict(BaseModel):
@@ -331,9 +341,35 @@ def is_scheduler_address(value: object) -> bool:
     return bool(sep) and scheme in _SCHEDULER_SCHEMES and bool(rest)
 
 
+class CreepConfig(_Strict):
+    """The creep observables (observable ``"creep"``): the reptation velocity and the creep events.
+
+    A network driven cyclically under a downhill load (``network.f_ext``
+    along +x) creeps: x_G advances by whole slips. With the observable
+    ``"creep"`` the result holds x_G at the end of every cycle of a periodic
+    driver and its advance over each cycle, the reptation velocity ``v_creep``
+    measured after ``transient`` (whole cycles only, with a periodic driver),
+    and the creep events: the avalanches that advance x_G along +x by more
+    than ``event_fraction`` times the reference slip
+    ell = 2 (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>, the slip of a slider of
+    mean threshold, mean normal load and one spring of mean stiffness
+    (docs/model.md section 3). They are computed exactly from the event
+    catalogue, which the kernel keeps for them (its rows enter the result
+    only with the observable ``"events"``).
+    """
+
+    transient: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+        0.0, description="Time, in tau_th, before which x_G is left out of the reptation velocity: v_creep "
+                         "is measured from the first cycle that starts at or after it (periodic driver) or "
+                         "from it (otherwise) to the end; >= 0 and < steps.")
+    event_fraction: PositiveFloat = Field(
+        0.25, description="A creep event is an avalanche whose advance of x_G along +x exceeds event_fraction "
+                          "times the reference slip ell = 2 (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>; > 0.")
+
+
 #: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
 NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
-Observable = Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events",
+Observable = Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events", "creep",
                      "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
 
 
@@ -380,6 +416,9 @@ class Config(_Strict):
     execution: ExecutionConfig = Field(
         default_factory=ExecutionConfig,
         description="Where the realizations run; never changes a result, and not part of a run's identity.")
+    creep: CreepConfig | None = Field(
+        None, description="Parameters of the observable 'creep' (the reptation velocity and the creep events); "
+                          "None: the defaults. Refused without that observable.")
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)
@@ -388,6 +427,15 @@ class Config(_Strict):
     @classmethod
     def _units_fill(cls, data: Any) -> Any:
         return _fill_from_units(data)
+
+    @model_serializer(mode="wrap")
+    def _leave_out_no_creep(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        # A run without [creep] dumps as it did before the table existed: its stored
+        # configuration, and so the identity of its checkpoints, are unchanged.
+        data = handler(self)
+        if isinstance(data, dict) and data.get("creep", 0) is None:
+            del data["creep"]
+        return data
 
     @model_validator(mode="after")
     def _units_agree(self) -> Config:
@@ -437,6 +485,16 @@ class Config(_Strict):
         if self.solver.kernel == "pair" and "events" in self.observables:
             raise ValueError("the 'events' observable (the event catalogue) needs a network kernel; "
                              "use 'solver.kernel = \"auto\"' or '\"csr\"'")
+        if self.solver.kernel == "pair" and "creep" in self.observables:
+            raise ValueError("the 'creep' observable (computed from the event catalogue) needs a network "
+                             "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
+        if self.creep is not None and "creep" not in self.observables:
+            raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
+                             "add \"creep\" to 'observables' or remove the table")
+        if "creep" in self.observables and self.creep_settings().transient >= self.steps:
+            raise ValueError(f"the 'creep.transient' value must be < steps = {self.steps} (the run's duration, "
+                             f"in tau_th), so that a reptation velocity is measured after it. "
+                             f"Got {self.creep_settings().transient!r} instead")
         return self
 
     @model_validator(mode="after")
@@ -466,13 +524,21 @@ class Config(_Strict):
             except (SlidernetError, OSError):
                 return None, False  # building the scene reports the file itself
             kernel = choose_kernel(self.solver.kernel, built.is_two_slider(), built.dim,
-                                   "events" in self.observables)
+                                   self.needs_catalogue())
             return built.dim, kernel == "pair"
         dim = 1 if net.kind in ("two_slider", "chain") else 2
         defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.f_ext
         two = net.kind == "two_slider" or (net.kind == "chain" and net.n == 2)
-        kernel = choose_kernel(self.solver.kernel, two and defaults, dim, "events" in self.observables)
+        kernel = choose_kernel(self.solver.kernel, two and defaults, dim, self.needs_catalogue())
         return dim, kernel == "pair"
+
+    def needs_catalogue(self) -> bool:
+        """True if the kernel keeps the event catalogue: for the observable 'events', or 'creep' (read from it)."""
+        return "events" in self.observables or "creep" in self.observables
+
+    def creep_settings(self) -> CreepConfig:
+        """The [creep] table, or its defaults where it is not given."""
+        return self.creep if self.creep is not None else CreepConfig()
 
     def distribution(self) -> TruncatedBelow:
         """The mu_s distribution, truncated below mu_d (built once, cached)."""
@@ -651,7 +717,7 @@ def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -
     """The kernel a scene runs on: the one rule, used by the scene and by the checks of a configuration.
 
     ``auto`` gives ``pair`` (scalars only) for the paper's two sliders unless
-    the event catalogue is asked for (it needs per-node state), and else the
+    the event catalogue is kept (observables "events" and "creep"; it needs per-node state), and else the
     network kernel of the dimension: ``csr`` in 1D, ``vec`` in 2D. A kernel
     named in ``solver.kernel`` is returned as it is (the scene refuses one
     that cannot run its network).

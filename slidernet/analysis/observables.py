@@ -91,6 +91,49 @@ def _event_catalogue(ds: Variables, records: list[Record], first_realization: in
                               "units": "1"})
 
 
+CREEP_EVENT_ATTRS = {
+    "time": ("time of the creep event (its avalanche's driving event)", "tau_th"),
+    "dx_G": ("advance of x_G along +x over the creep event's avalanche", "l0"),
+    "wait": ("waiting time since the previous creep event (NaN for the first)", "tau_th"),
+}
+CREEP_VARIABLES = {
+    "x_G_cycle": ("cycle", "x_G at the end of the cycle", "l0"),
+    "dx_G_cycle": ("cycle", "advance of x_G over the cycle", "l0"),
+    "v_creep": ((), "reptation velocity: mean rate of x_G after creep.transient", "l0/tau_th"),
+    "v_creep_cycle": ((), "reptation velocity per cycle: mean advance of x_G per whole cycle after "
+                          "creep.transient (NaN without a periodic driver)", "l0"),
+    "v_creep_cycles_sem": ((), "standard error of v_creep from the spread of the advances of its cycles "
+                               "(NaN without 2 whole cycles after creep.transient)", "l0/tau_th"),
+}
+
+
+def _padded(rows: list[np.ndarray], width: int) -> np.ndarray:
+    """Ragged rows as one array (len(rows), width), padded with NaN."""
+    out = np.full((len(rows), width), np.nan)
+    for b, row in enumerate(rows):
+        out[b, : row.size] = row
+    return out
+
+
+def _creep_variables(ds: Variables, records: list[Record]) -> None:
+    """The creep observables (:mod:`slidernet.solver.creep`): per cycle, the velocity, the creep events."""
+    for name, (dim, long_name, units) in CREEP_VARIABLES.items():
+        if name in records[0]:
+            ds[name] = (("realization", *((dim,) if dim else ())), np.stack([r[name] for r in records]),
+                        {"long_name": long_name, "units": units})
+    events = [r["creep_events"] for r in records]
+    counts = np.array([e["time"].size for e in events], np.int64)
+    ds["creep_event_count"] = ("realization", counts, {"long_name": "number of creep events", "units": "1"})
+    width = int(counts.max())
+    # The scene's constants (the same in every record): the reference slip and the events' threshold.
+    constants = {"reference_slip": float(records[0]["creep_slip"]),
+                 "event_threshold": float(records[0]["creep_threshold"])}
+    for name, (long_name, units) in CREEP_EVENT_ATTRS.items():
+        var = "creep_waiting_time" if name == "wait" else f"creep_event_{name}"
+        ds[var] = (("realization", "creep_event"), _padded([e[name] for e in events], width),
+                   {"long_name": long_name + "; NaN past creep_event_count", "units": units, **constants})
+
+
 def realization_variables(records: list[Record], observables: list[str], first_realization: int = 0) -> Variables:
     """The per-realization variables of consecutive realizations, stacked.
 
@@ -115,7 +158,21 @@ def realization_variables(records: list[Record], observables: list[str], first_r
         if name in observables:
             out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
     _network_variables(out, records, first_realization)
+    if "creep_events" in records[0]:
+        _creep_variables(out, records)
     return out
+
+
+def pad_creep_events(parts: list[Variables]) -> None:
+    """Pad the creep events of consecutive chunks of :func:`realization_variables` to one width, in place."""
+    names = [name for name, (dims, _, _) in parts[0].items() if "creep_event" in dims]
+    if not names:
+        return
+    width = max(p[names[0]][1].shape[1] for p in parts)
+    for p in parts:
+        for name in names:
+            dims, data, attrs = p[name]
+            p[name] = (dims, np.pad(data, ((0, 0), (0, width - data.shape[1])), constant_values=np.nan), attrs)
 
 
 def _undefined_sem(shape: tuple[int, ...]) -> np.ndarray:
@@ -173,6 +230,9 @@ class EnsembleStats:
                     self._merge("x_G2", x**2)
         if "n" in self.observables and self.steps > 0:
             self._merge("r", np.array([[r["n"][-1] / self.steps] for r in records]))
+        for name in ("v_creep", "v_creep_cycle"):
+            if name in records[0]:
+                self._merge(name, np.array([[r[name]] for r in records], dtype=np.float64))
         if "mu_eff" in self.observables:
             fsum = np.stack([r["f_sum"] for r in records])
             count = np.stack([r["f_count"] for r in records]).astype(float)
@@ -215,6 +275,13 @@ class EnsembleStats:
             mean, sem = self._mean_sem("r")
             out["r_mean"] = ((), mean[0], {"long_name": "mean rearrangements per tau_th", "units": "1"})
             out["r_sem"] = ((), sem[0], {"long_name": "standard error of r_mean", "units": "1"})
+        for name in ("v_creep", "v_creep_cycle"):
+            if name in self._moments:
+                mean, sem = self._mean_sem(name)
+                units = CREEP_VARIABLES[name][2]
+                out[f"{name}_mean"] = ((), mean[0], {"long_name": f"ensemble mean of {name}", "units": units})
+                out[f"{name}_sem"] = ((), sem[0], {"long_name": f"standard error of {name}_mean over the "
+                                                                f"realizations", "units": units})
         if self._f:
             f, R = self._f, self.R
             total = f["c"]
@@ -246,7 +313,8 @@ def chunks(records: Iterable[Record], size: int = CHUNK) -> Iterator[list[Record
 
 
 def coordinates(t: np.ndarray, R: int, first: Record) -> dict[str, tuple]:
-    """The coordinates of the result: ``realization``, ``t`` and, for networks, ``avalanche_size``."""
+    """The coordinates of the result: ``realization``, ``t``, for networks ``avalanche_size``, and with a
+    periodic driver and the observable ``creep`` ``cycle`` and ``cycle_end``."""
     coords: dict[str, tuple] = {
         "realization": ("realization", np.arange(R, dtype=np.int64)),
         "t": ("t", np.asarray(t, dtype=np.int64), {"long_name": "time", "units": "tau_th"}),
@@ -254,6 +322,13 @@ def coordinates(t: np.ndarray, R: int, first: Record) -> dict[str, tuple]:
     if "avalanche_count" in first:
         bins = first["avalanche_count"].size
         coords["avalanche_size"] = ("avalanche_size", 2 ** np.arange(bins, dtype=np.int64))
+    if "cycle_end" in first:
+        C = first["cycle_end"].size
+        coords["cycle"] = ("cycle", np.arange(1, C + 1, dtype=np.int64),
+                           {"long_name": "cycle of the periodic driver (cycle c ends at t = c period)",
+                            "units": "1"})
+        coords["cycle_end"] = ("cycle", np.asarray(first["cycle_end"], dtype=np.float64),
+                               {"long_name": "end of the cycle, c period", "units": "tau_th"})
     return coords
 
 
@@ -295,6 +370,7 @@ def assemble(
         R += len(chunk)
     if first is None:
         raise ValueError("assemble needs at least one realization")
+    pad_creep_events(parts)
     data = {name: (dims, np.concatenate([p[name][1] for p in parts]), a)
             for name, (dims, _, a) in parts[0].items()}
     ds = xr.Dataset(data, coords=coordinates(t, R, first), attrs=dict(attrs))

@@ -48,10 +48,13 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
         dims = (dims,) if isinstance(dims, str) else tuple(dims)
         for i, d in enumerate(dims):  # dimensions without a coordinate (node)
             if d not in nc.dimensions:
-                nc.createDimension(d, data.shape[i])
-        fixed = {"realization": min(CHUNK, R), "event": 1 << 16}
+                # The creep events are padded to the most of any realization, known only at the end.
+                nc.createDimension(d, None if d == "creep_event" else data.shape[i])
+        fixed = {"realization": min(CHUNK, R), "event": 1 << 16, "creep_event": 256}
         sizes = [fixed.get(d) or max(1, len(nc.dimensions[d])) for d in dims]
-        var = nc.createVariable(name, data.dtype, dims, fill_value=False, chunksizes=sizes or None,
+        # Rows of creep events shorter than the dimension read NaN, as assemble pads them.
+        fill = np.nan if "creep_event" in dims else False
+        var = nc.createVariable(name, data.dtype, dims, fill_value=fill, chunksizes=sizes or None,
                                 contiguous=not dims)
         var.setncatts(var_attrs)
         return var
@@ -63,7 +66,8 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
         for chunk in chunks(records):
             if r0 == 0:
                 for name, (dim, data, *rest) in coordinates(t, R, chunk[0]).items():
-                    nc.createDimension(dim, data.size)
+                    if dim not in nc.dimensions:  # cycle_end shares the dimension cycle
+                        nc.createDimension(dim, data.size)
                     create(nc, name, (dim,), data, rest[0] if rest else {})[:] = data
                 if "events" in chunk[0]:
                     nc.createDimension("event", None)
@@ -73,6 +77,8 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
                 var = nc.variables[name] if name in nc.variables else create(nc, name, dims, data, var_attrs)
                 if dims in ("event", ("event",)):
                     var[offset:offset + data.shape[0]] = data
+                elif "creep_event" in dims:
+                    var[r0:r0 + data.shape[0], :data.shape[1]] = data
                 else:
                     var[r0:r0 + data.shape[0]] = data
             stats.add(chunk)

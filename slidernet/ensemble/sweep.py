@@ -531,6 +531,10 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarra
             raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the 'events' observable (the event "
                               f"catalogue, whose length differs from run to run) cannot be swept; run the "
                               f"points one by one with slidernet.run.")
+        if "creep" in c.observables:
+            raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the 'creep' observable (creep events "
+                              f"and cycles, whose numbers differ from run to run) cannot be swept; run the "
+                              f"points one by one with slidernet.run.")
         if not np.array_equal(times[i][:t_common.size], t_common):
             raise refuse(shortest, i, f"the points are stacked along t, so the recorded times of point {i} must "
                          f"begin with those of point {shortest} (the fewest steps); to sweep 'steps', record "

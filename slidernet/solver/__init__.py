@@ -6,6 +6,9 @@
   the order in which its draws are read;
 - :mod:`~slidernet.solver.realization`: :class:`Realization`, one
   realization's state, advanced by the compiled kernels.
+- :mod:`~slidernet.solver.creep`: the creep observables of one realization
+  (x_G per cycle, the reptation velocity, the creep events), reduced from its
+  event catalogue.
 """
 
 from slidernet.solver.realization import Realization, simulate

@@ -19,6 +19,7 @@ from slidernet import kernels
 from slidernet.errors import AvalancheError, TiltTestError
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver.backends import backend_for
+from slidernet.solver.creep import creep_record
 from slidernet.solver.scene import Scene, tilt_avalanche_cap
 from slidernet.solver.streams import _refill, horizontal_draws, realization_streams
 
@@ -303,7 +304,9 @@ class Realization:
         dict of str to ndarray
             ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
             (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
-            record bin, shape (T,), and the scalar ``n_events``.
+            record bin, shape (T,), and the scalar ``n_events``; the backend's
+            own (``backend.result``), and with the observable
+            ``creep`` those of :func:`slidernet.solver.creep.creep_record`.
         """
         res = {k: v.copy() for k, v in self.out.items()}
         Ntilde = self.scene.network.Ntilde
@@ -312,6 +315,12 @@ class Realization:
             res["y_G"] *= Ntilde
         res["n_events"] = np.int64(self.state["n_events"][0])
         res.update(self.backend.result(self))
+        scene = self.scene
+        if scene.creep is not None:
+            res.update(creep_record(res["events"], res["events_complete"], scene.steps, scene.creep))
+        if scene.catalogue and not scene.keep_events:
+            # Kept for the creep observables only: the rows stay out of the records.
+            del res["events"], res["events_complete"]
         return res
 
 

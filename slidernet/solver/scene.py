@@ -13,6 +13,7 @@ from slidernet.errors import ConfigError
 from slidernet.kernels import Chain, Plane, Settings
 from slidernet.kernels.assembly import diagonal_positions
 from slidernet.model.network import Network
+from slidernet.solver.creep import CreepSpec, reference_slip
 
 
 def record_times(steps: int, record: str | list[int], per_decade: int = 20) -> np.ndarray:
@@ -135,8 +136,10 @@ class Scene:
     batch: int
     recompute_every: int
     slip_mode: int
-    catalogue: bool = False
+    catalogue: bool = False  # the kernel keeps the event catalogue (for 'events' or 'creep')
     max_events: int = 0
+    keep_events: bool = True  # the catalogue's rows go into the result (observable 'events')
+    creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
     operators: Chain | Plane | None = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
     _K: Any = field(default=None, repr=False)
@@ -170,7 +173,7 @@ class Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
         family, operators = _operators(net)
-        catalogue = "events" in cfg.observables
+        catalogue = cfg.needs_catalogue()
         kernel = choose_kernel(cfg.solver.kernel, net.is_two_slider(), net.dim, catalogue)
         if kernel != family and not (kernel == "pair" and net.is_two_slider()):
             raise ConfigError(
@@ -202,8 +205,27 @@ class Scene:
             slip_mode=1 if cfg.solver.slip == "exact" else 0,
             catalogue=catalogue,
             max_events=cfg.solver.max_events,
+            keep_events="events" in cfg.observables,
+            creep=creep_spec(cfg, net) if "creep" in cfg.observables else None,
             operators=operators,
         )
+
+
+def creep_spec(cfg: Config, net: Network) -> CreepSpec:
+    """The creep observables' settings: the driver's period, the transient, the reference slip and threshold."""
+    settings = cfg.creep_settings()
+    try:
+        mu_s_mean = float(cfg.distribution().mean_max(1))
+    except Exception as exc:  # a plugin law without the quantile functions the mean is integrated from
+        raise ConfigError(
+            f"The 'creep' observable needs the mean of p(mu_s) for its reference slip, and the distribution "
+            f"{cfg.friction.static.name!r} gives none: {exc}"
+        ) from None
+    slip = reference_slip(mu_s_mean, cfg.friction.mu_d, net.normal_load, net.k, net.Ntilde)
+    period = getattr(cfg.driver_plugin(), "period", None)
+    return CreepSpec(period=None if period is None else float(period), transient=float(settings.transient),
+                     slip=slip, threshold=settings.event_fraction * slip,
+                     weights=(net.normal_load / net.normal_load.sum()).astype(np.float64))
 
 
 def pair_tilt_applies(net: Network) -> bool:
