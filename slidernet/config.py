@@ -657,6 +657,7 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             # dict.fromkeys: a union reports one error per member, often alike.
             lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
             raise ConfigError(f"Invalid configuration:\n{lines}") from None
+    cfg.distribution()
     _check_incline_holds(cfg)
     driver = cfg.driver_plugin()
     # An optional hook: a driver that cannot cover the run (a recorded series

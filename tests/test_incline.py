@@ -137,6 +137,16 @@ def test_a_lattice_on_a_slope_above_mu_d_slides_away():
     assert (res["y_G"] == res["y_G"][-1]).sum() >= 1
 
 
+def test_a_uniform_f_ext_above_mu_d_that_moves_every_node_at_t0_slides_away_at_t0():
+    # Before sliding away existed this relaxed to rest after 8 slips (one slider with mu_s < 0.55
+    # set the whole chain in motion); by the tilt test's rule that is the network sliding away.
+    cfg = incline_config(None, {"kind": "chain", "n": 8, "f_ext": 0.55})
+    cfg["friction"]["static"] = {"name": "gaussian", "mean": 0.6, "std": 0.05}
+    real = realization(cfg).advance(0)
+    assert real.slid_away and real.result()["slid_away_at"] == 0.0
+    assert real.n == 8
+
+
 def test_an_avalanche_past_max_avalanche_on_a_slope_above_mu_d_is_sliding_away():
     cfg = incline_config(0.55, solver={"max_avalanche": 1})
     real = realization(cfg).advance()
