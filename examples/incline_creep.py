@@ -1,5 +1,5 @@
 """Thermal creep on an incline: reptation, its plateaus, the critical amplitude and intermittency
-=============================================================================================
+==============================================================================================
 
 Chains of sliders rest on an incline (``network.incline``, downhill along
 +x) and the springs dilate with a sinusoidal temperature cycle (driver

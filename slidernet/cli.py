@@ -21,11 +21,12 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from slidernet.errors import RunInterrupted, SlidernetError, UnknownPluginError
+from slidernet.errors import RunInterrupted, SlidAwayWarning, SlidernetError, UnknownPluginError
 
 if TYPE_CHECKING:
     from slidernet.plugins.registry import Registry
@@ -140,12 +141,18 @@ def _execution_flags(p: argparse.ArgumentParser) -> None:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
-    from slidernet.ensemble.runner import run
+    from slidernet.ensemble.runner import all_slid_away, run
 
     cfg = load_config(args.config)  # validate before any work or any file
-    with run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
-             scheduler=args.scheduler, overwrite=args.overwrite, scheduler_timeout=args.scheduler_timeout) as ds:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SlidAwayWarning)  # said below, once, as a line of its own
+        ds = run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
+                 scheduler=args.scheduler, overwrite=args.overwrite, scheduler_timeout=args.scheduler_timeout)
+    with ds:
         print(f"wrote {args.out / 'result.nc'} (seed {ds.attrs['seed']}, kernel {ds.attrs['kernel']})")
+        slid = all_slid_away(ds)
+        if slid is not None:
+            print(f"slidernet: {slid}")
     return 0
 
 

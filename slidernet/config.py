@@ -97,6 +97,9 @@ class NetworkConfig(_Strict):
     the default 1 on every spring or node. ``f_ext`` (in units of N) is a
     constant external tangential force on every slider: a number is a force
     along x, ``[fx, fy]`` a 2D force (2D networks only); default 0.
+    ``incline`` (degrees, in [0, 90)) tilts the substrate along +x (downhill
+    is +x): each slider keeps its normal load N_i and feels the downhill
+    force N_i tan(incline) along x, as its ``f_ext``; give one or the other.
     """
 
     kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = Field(
@@ -123,6 +126,26 @@ class NetworkConfig(_Strict):
     f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = Field(
         None, description="Constant external tangential force on every slider, in units of N: a number "
                           "along x, or [fx, fy] (2D networks only); None: 0.")
+    incline: FiniteFloat | None = Field(
+        None, description="Angle of the substrate in degrees, in [0, 90), downhill along +x: every slider "
+                          "feels N_i tan(incline) along x as its f_ext (docs/model.md, 'External force'); "
+                          "not with f_ext. None: horizontal.")
+
+    @field_validator("incline")
+    @classmethod
+    def _incline_range(cls, value: float | None) -> float | None:
+        if value is not None and not 0.0 <= value < 90.0:
+            raise ValueError(f"must be in [0, 90) degrees. Got {value!r} instead")
+        return value
+
+    @model_serializer(mode="wrap")
+    def _dump(self, handler: Any) -> dict[str, Any]:
+        # A horizontal network's dump (the config stored with a result, run.json) stays as it was
+        # before 'incline' existed, so that earlier results and interrupted runs still match it.
+        data = handler(self)
+        if self.incline is None:
+            data.pop("incline", None)
+        return data
 
     @model_validator(mode="after")
     def _params_match_kind(self) -> NetworkConfig:
@@ -141,12 +164,19 @@ class NetworkConfig(_Strict):
         if isinstance(self.f_ext, tuple) and self.kind in ("two_slider", "chain"):
             raise ValueError(f"a {self.kind} network is 1D: 'f_ext' must be a number (the force along x), "
                              f"not {list(self.f_ext)}")
+        if self.incline is not None and self.f_ext is not None:
+            raise ValueError("'network.incline' and 'network.f_ext' both set the tangential load on the sliders; "
+                             "give one or the other (an incline is f_ext = N_i tan(incline) along x)")
         return self
+
+    def tangential_load(self) -> bool:
+        """True if a nonzero f_ext or incline loads the sliders (known without a file)."""
+        return bool(self.f_ext) or bool(self.incline)
 
     def pair_tilt_applies(self) -> bool:
         """True if the appendix's two-slider tilt test applies (when known without a file)."""
         return (self.kind == "two_slider" or (self.kind == "chain" and self.n == 2)) \
-            and self.normal_load in (None, 1.0) and not self.f_ext
+            and self.normal_load in (None, 1.0) and not self.tangential_load()
 
     def size(self) -> int | None:
         """Number of sliders, when known without reading a file."""
@@ -527,7 +557,7 @@ class Config(_Strict):
                                    self.needs_catalogue())
             return built.dim, kernel == "pair"
         dim = 1 if net.kind in ("two_slider", "chain") else 2
-        defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.f_ext
+        defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.tangential_load()
         two = net.kind == "two_slider" or (net.kind == "chain" and net.n == 2)
         kernel = choose_kernel(self.solver.kernel, two and defaults, dim, self.needs_catalogue())
         return dim, kernel == "pair"
@@ -685,6 +715,7 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
             raise ConfigError(f"Invalid configuration:\n{lines}") from None
     cfg.distribution()
+    _check_incline_holds(cfg)
     driver = cfg.driver_plugin()
     # An optional hook: a driver that cannot cover the run (a recorded series
     # too short) says so now, before any work.
@@ -697,6 +728,25 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     return cfg
 
 
+def _check_incline_holds(cfg: Config) -> None:
+    """Refuse an incline steeper than every threshold: tan(incline) >= mu_s for every slider.
+
+    Such a network can never rest: every slider is unstable on its own from
+    t = 0 on. The law's upper end is taken after its truncation at mu_d.
+    """
+    incline = cfg.network.incline
+    if not incline:
+        return
+    hi = cfg.distribution().support()[1]
+    slope = math.tan(math.radians(incline))
+    if hi <= slope:
+        raise ConfigError(
+            f"The 'network.incline' field: tan({incline!r} degrees) = {slope!r} is at or above every static "
+            f"threshold (the law {cfg.friction.static.name!r} of 'friction.static' ends at mu_s = {hi!r}), so no "
+            f"slider can rest on it. Use a smaller angle."
+        )
+
+
 def is_finite(x: float) -> bool:
     """True for a finite float (helper for plugin validation)."""
     return math.isfinite(x)
@@ -707,10 +757,16 @@ def build_network(cfg: Config) -> Network:
     from slidernet.model.builders import build
 
     net_cfg = cfg.network
-    params = net_cfg.model_dump(exclude={"kind", "Ntilde", "seed"}, exclude_none=True)
+    params = net_cfg.model_dump(exclude={"kind", "Ntilde", "seed", "incline"}, exclude_none=True)
     # seed None means 0, not fresh entropy: a network is part of the scene.
     rng = np.random.Generator(np.random.PCG64(net_cfg.seed or 0))
-    return build(net_cfg.kind, params, net_cfg.Ntilde, rng)
+    net = build(net_cfg.kind, params, net_cfg.Ntilde, rng)
+    if net_cfg.incline:
+        # The downhill pull of gravity on a slider of normal load N_i: N_i tan(incline) along +x.
+        f_ext = np.zeros((net.n_nodes, net.dim))
+        f_ext[:, 0] = math.tan(math.radians(net_cfg.incline)) * net.normal_load
+        net.f_ext = f_ext
+    return net
 
 
 def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -> str:

@@ -61,6 +61,10 @@ class RunInterrupted(KeyboardInterrupt):
         self.signum = int(signum)
 
 
+class SlidAwayWarning(UserWarning):
+    """Every realization of a run slid away down its incline (its ``slid_away_at`` is finite)."""
+
+
 def param_error(param: str, owner: str, requirement: str, got: object) -> ConfigError:
     """Build the standard message for a bad parameter value.
 

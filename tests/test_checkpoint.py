@@ -243,15 +243,16 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     header = json.loads(arrays["header"].tobytes())
     arrays["header"] = np.frombuffer(json.dumps({**header, "version": 99}).encode(), np.uint8)
     np.savez(tmp_path / "future.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 5"):
+    with pytest.raises(CheckpointError, match=r"layout version 99; this slidernet reads version 6"):
         load_realization(scene, ss, tmp_path / "future.npz")
     # Checkpoints of the layouts before the per-kernel backends (version 2), before the named
     # state (version 3: slot arrays ist and fst) and before the driving trees and K's block table
-    # (version 4: three heap rows) are refused, not misread.
-    for old in (2, 3, 4):
+    # (version 4: three heap rows), and before sliding away (version 5: no count of the moving
+    # nodes) are refused, not misread.
+    for old in (2, 3, 4, 5):
         arrays["header"] = np.frombuffer(json.dumps({**header, "version": old}).encode(), np.uint8)
         np.savez(tmp_path / "old.npz", **arrays)
-        with pytest.raises(CheckpointError, match=rf"layout version {old}; this slidernet reads version 5"):
+        with pytest.raises(CheckpointError, match=rf"layout version {old}; this slidernet reads version 6"):
             load_realization(scene, ss, tmp_path / "old.npz")
     with pytest.raises(FileNotFoundError):
         load_realization(scene, ss, tmp_path / "missing.npz")

@@ -100,7 +100,7 @@ def test_chain_aging_quick(tmp_path):
 
 
 def test_incline_creep_quick(tmp_path):
-    """The --quick preset (seeds fixed in the script): the pair's staircase is the theory's, creep stops below A_c."""
+    """The --quick preset (seeds fixed in the script): the pair's staircase is the theory's; no creep below A_c."""
     import json
 
     import numpy as np

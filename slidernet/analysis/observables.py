@@ -160,6 +160,10 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     _network_variables(out, records, first_realization)
     if "creep_events" in records[0]:
         _creep_variables(out, records)
+    if "slid_away_at" in records[0]:  # a scene that can slide away (docs/model.md, 'Sliding away')
+        out["slid_away_at"] = ("realization", np.array([r["slid_away_at"] for r in records], np.float64), {
+            "long_name": "time at which the network slid away (NaN: it did not); the records after it "
+                         "hold the state of that moment", "units": "tau_th"})
     return out
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import signal
 import time
+import warnings
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,7 @@ from slidernet.analysis.observables import CHUNK, assemble
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
 from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
 from slidernet.ensemble.stream import write_result_stream
-from slidernet.errors import CheckpointError, RunInterrupted, param_error
+from slidernet.errors import CheckpointError, RunInterrupted, SlidAwayWarning, param_error
 from slidernet.io import read_result
 from slidernet.io.store import RunStore
 
@@ -171,11 +172,33 @@ def run(
         raise
     attrs = _attrs(cfg, scene.kernel, workers, scheduler)
     if store is None:
-        return assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
-    path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
-                               list(cfg.observables), attrs)
-    store.remove()
-    return xr.open_dataset(path, engine="netcdf4")
+        ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
+    else:
+        path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
+                                   list(cfg.observables), attrs)
+        store.remove()
+        ds = xr.open_dataset(path, engine="netcdf4")
+    warn_if_all_slid_away(ds)
+    return ds
+
+
+def all_slid_away(ds: xr.Dataset) -> str | None:
+    """One line saying that every realization of ``ds`` slid away, or None if one did not."""
+    if "slid_away_at" not in ds:
+        return None
+    at = ds["slid_away_at"].values
+    if not np.isfinite(at).all():
+        return None
+    return (f"every realization ({at.size}) slid away, between t = {at.min():.6g} and {at.max():.6g} tau_th: "
+            f"the load along x per unit normal load exceeds mu_d; the records after 'slid_away_at' hold the "
+            f"state of the slide")
+
+
+def warn_if_all_slid_away(ds: xr.Dataset) -> None:
+    """Warn (:class:`~slidernet.errors.SlidAwayWarning`) if every realization of ``ds`` slid away."""
+    line = all_slid_away(ds)
+    if line is not None:
+        warnings.warn(line[0].upper() + line[1:] + ".", SlidAwayWarning, stacklevel=3)
 
 
 def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore | None,

@@ -69,7 +69,8 @@ FORMAT = "slidernet-checkpoint"
 # 4: named state (state/<field>, buffers/<name>, the backend's nodes/ and heaps/).
 # 5: the driving events from tournament trees (heaps/tkey, twin, toff, leaf; one heap row, not three),
 #    and the scene's fingerprint digests K as the 2D kernels hold it (block ids and their table).
-VERSION = 5
+# 6: sliding away (state/moving_id, n_moving, slid_away, slid_away_at; backend nodes/moving).
+VERSION = 6
 
 # Attributes written to the file (by name, or with special handling below).
 _SAVED = {"state", "mu", "buffers", "out", "rngs", "draws", "backend", "_tilted"}

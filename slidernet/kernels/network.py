@@ -42,7 +42,7 @@ from slidernet.kernels.heap import (
     tree_set,
     write_output,
 )
-from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, UNSTABLE, UP, kernel_jit
+from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, kernel_jit
 from slidernet.kernels.tilt import tilt_sample
 
 
@@ -73,6 +73,34 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
     move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node)
     return True
+
+
+@kernel_jit(inline="always")
+def every_node_moving(st, nodes, i):
+    """Count node i among the nodes the current avalanche has set in motion; True once that is all of them.
+
+    The avalanche's id is ``st.n_events`` (0: the relaxation at t = 0);
+    ``nodes.moving`` stamps each node with the last avalanche it slipped in,
+    so the count costs O(1) per slip and nothing between avalanches.
+    """
+    av = st.n_events
+    if st.moving_id != av:
+        st.moving_id = av
+        st.n_moving = 0
+    if nodes.moving[i] != av:
+        nodes.moving[i] = av
+        st.n_moving += 1
+    return st.n_moving == nodes.mu.size
+
+
+@kernel_jit(inline="always")
+def slide_away(st, nodes, out, out_steps):
+    """The network slides away: record when, and hold the state of that moment in the records left."""
+    st.slid_away = 1
+    st.slid_away_at = st.event_time
+    while st.next_out < out_steps.size:
+        write_output(st, nodes.mu, out)
+    return SLID_AWAY
 
 
 @kernel_jit(inline="always")
@@ -142,6 +170,13 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
     forces from the displacements and rebuilds the heaps, and
     ``AVALANCHE_LIMIT`` (node in ``err_node``). An unstable initial state (a
     large f_ext) is relaxed first, as part of t = 0.
+
+    With ``settings.slide_away`` (the mean load along x exceeds mu_d) an
+    avalanche that sets every node in motion, or that exceeds ``max_slips``
+    slips (a part sliding alone), is the network sliding away: the kernel
+    sets ``slid_away`` and ``slid_away_at`` (the avalanche's event time),
+    writes the state of that moment into every output step left, and
+    returns ``SLID_AWAY``; the realization is over.
     """
     st = state[0]
     steps = thetas.size - 1
@@ -151,6 +186,8 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             i = heaps.node[UNSTABLE, 0]
             st.av_slips += 1
             if st.av_slips > settings.max_slips:
+                if settings.slide_away:
+                    return slide_away(st, nodes, out, out_steps)
                 st.err_node = i
                 return AVALANCHE_LIMIT
             # The buffer check comes first: a kernel that returns after the
@@ -165,6 +202,8 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
                              slip_displacement, move_node):
                 st.err_node = i
                 return AVALANCHE_LIMIT
+            if settings.slide_away and every_node_moving(st, nodes, i):
+                return slide_away(st, nodes, out, out_steps)
         avalanche_done(st, nodes.avalanche_count)
         if st.started == 0 and settings.do_tilt:
             # The tilt test before each rearrangement needs f_ext = 0, so
@@ -193,6 +232,8 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
                              slip_displacement, move_node):
                 st.err_node = best
                 return AVALANCHE_LIMIT
+            if settings.slide_away and every_node_moving(st, nodes, best):
+                return slide_away(st, nodes, out, out_steps)
             continue
         if end_step(st, thetas, out_steps):
             write_output(st, nodes.mu, out)

@@ -117,6 +117,7 @@ AVALANCHE_LIMIT = 3  # an avalanche exceeded max_slips
 TILT_LIMIT = 4  # a tilt test exceeded its iteration cap
 RECOMPUTE = 5  # time to recompute the forces from the displacements (drift control)
 NEED_EVENTS = 6  # the event catalogue's buffer is full
+SLID_AWAY = 7  # the network slid away (Settings.slide_away): the realization is over
 
 TILT_MAX_ITER = 1_000_000
 N_AVALANCHE_BINS = 63  # avalanche sizes s are binned by floor(log2 s); 2**62 fits in int64
@@ -142,6 +143,10 @@ STATE = np.dtype([
     ("since_recompute", np.int64),  # slips since the forces were last recomputed from u
     ("argmax", np.int64),  # node holding mu_max
     ("err_node", np.int64),  # node named by an error return
+    # sliding away (network kernels, only with Settings.slide_away)
+    ("moving_id", np.int64),  # the avalanche (id: n_events) whose moving nodes n_moving counts
+    ("n_moving", np.int64),  # distinct nodes that have slipped in that avalanche
+    ("slid_away", np.int64),  # 1 once the network slid away
     # the event catalogue
     ("ev_pos", np.int64),  # rows written to the catalogue's buffer
     ("ev_on", np.int64),  # 1 while the catalogue is recorded
@@ -152,6 +157,7 @@ STATE = np.dtype([
     ("y_G", np.float64),  # 2D kernel: the same along y
     ("mu_max", np.float64),  # largest threshold mu_s
     ("event_time", np.float64),  # time of the current driving event, tau_th (q + fraction of the step)
+    ("slid_away_at", np.float64),  # event_time of the avalanche that slid away (set with slid_away)
 ])
 
 
@@ -283,6 +289,8 @@ class Nodes(NamedTuple):
     mu: np.ndarray  # (N,): thresholds mu_s
     node_slips: np.ndarray  # (N,) int64: slips of each node
     avalanche_count: np.ndarray  # (N_AVALANCHE_BINS,) int64: avalanches by floor(log2 size)
+    moving: np.ndarray  # (N,) int64: the avalanche (id) in which the node last slipped; -1: none.
+    # Written only with Settings.slide_away.
 
 
 class Chain(NamedTuple):
@@ -328,3 +336,7 @@ class Settings(NamedTuple):
     recompute_every: int  # slips between recomputations of the forces (0: never)
     do_tilt: bool  # the appendix's tilt test before every rearrangement (a 1D pair)
     slip_mode: int  # 2D: SLIP_STRAIGHT (0) or SLIP_EXACT (1)
+    # The mean load along x per unit normal load, sum_i f_ext,i,x / sum_i N_i, exceeds mu_d: an
+    # avalanche that sets every node in motion is the network sliding away (network kernels). False:
+    # the kernels keep no count of the moving nodes at all.
+    slide_away: bool = False

@@ -160,15 +160,24 @@ class Realization:
         state at every recorded time passed on the way.
         """
         scene = self.scene
+        if self.slid_away:
+            return self  # the realization ended when it slid away
         to_step = scene.steps if to_step is None else int(to_step)
         if not self.step <= to_step <= scene.steps:
             raise ValueError(f"to_step must lie in [{self.step}, {scene.steps}]; got {to_step}")
         if scene.tilt_at == "records":
             while self._tilted < scene.out_steps.size and scene.out_steps[self._tilted] <= to_step:
                 self._run_kernel(int(scene.out_steps[self._tilted]))
+                if self.slid_away:
+                    return self  # no tilt test of a sliding network: mu_eff_count stays 0 from here on
                 self._tilt_record(self._tilted)
                 self._tilted += 1
         return self._run_kernel(to_step)
+
+    @property
+    def slid_away(self) -> bool:
+        """True once the network slid away (docs/model.md, 'Sliding away'): the realization is over."""
+        return bool(self.state["slid_away"][0])
 
     def tilt_test(self) -> float:
         """One network tilt test on a copy of the current state: mu_eff, the load at which it slides.
@@ -251,6 +260,11 @@ class Realization:
             status = self.backend.run(self, thetas)
             if status == kernels.DONE:
                 return self
+            if status == kernels.SLID_AWAY:
+                # The kernel has held the records left at the state of the slide; the realization
+                # is over, at its last step for whoever advances it.
+                st["q"] = scene.steps
+                return self
             if status == kernels.NEED_MU:
                 fresh = _refill(self.buffers.mu, st["mu_pos"][0], draw_mu, scene.batch)
                 self.buffers = self.buffers._replace(mu=fresh)
@@ -304,7 +318,9 @@ class Realization:
         dict of str to ndarray
             ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
             (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
-            record bin, shape (T,), and the scalar ``n_events``; the backend's
+            record bin, shape (T,), and the scalar ``n_events``; where the
+            scene can slide away (``scene.records_slide``), the scalar
+            ``slid_away_at`` (tau_th; NaN if it did not); the backend's
             own (``backend.result``), and with the observable
             ``creep`` those of :func:`slidernet.solver.creep.creep_record`.
         """
@@ -314,6 +330,8 @@ class Realization:
         if "y_G" in res:
             res["y_G"] *= Ntilde
         res["n_events"] = np.int64(self.state["n_events"][0])
+        if self.scene.records_slide:
+            res["slid_away_at"] = np.float64(self.state["slid_away_at"][0] if self.slid_away else np.nan)
         res.update(self.backend.result(self))
         scene = self.scene
         if scene.creep is not None:

@@ -120,6 +120,11 @@ class Scene:
         The network's operators the kernels run on (see ``_operators``).
     K : scipy.sparse matrix
         The stiffness matrix (a property, built from ``operators`` on first use).
+    slide_away : bool
+        The mean load along x per unit normal load, :func:`mean_load`,
+        exceeds mu_d: a realization can slide away, and the kernels watch for it.
+    records_slide : bool
+        The result has ``slid_away_at``: with ``slide_away``, and on any incline.
     """
 
     network: Network
@@ -140,6 +145,8 @@ class Scene:
     max_events: int = 0
     keep_events: bool = True  # the catalogue's rows go into the result (observable 'events')
     creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
+    slide_away: bool = False
+    records_slide: bool = False
     operators: Chain | Plane | None = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
     _K: Any = field(default=None, repr=False)
@@ -166,7 +173,7 @@ class Scene:
         """The run's constants, as the kernels take them."""
         return Settings(mu_d=float(self.mu_d), max_slips=int(self.max_avalanche),
                         recompute_every=int(self.recompute_every), do_tilt=bool(self.do_tilt),
-                        slip_mode=int(self.slip_mode))
+                        slip_mode=int(self.slip_mode), slide_away=bool(self.slide_away))
 
     @classmethod
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
@@ -188,6 +195,7 @@ class Scene:
                     "The 'mu_eff_at' field: the tilt test before every rearrangement (the appendix) "
                     "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records'."
                 )
+        slide_away = mean_load(net) > cfg.friction.mu_d
         return cls(
             network=net,
             distribution=cfg.distribution(),
@@ -207,6 +215,8 @@ class Scene:
             max_events=cfg.solver.max_events,
             keep_events="events" in cfg.observables,
             creep=creep_spec(cfg, net) if "creep" in cfg.observables else None,
+            slide_away=slide_away,
+            records_slide=slide_away or cfg.network.incline is not None,
             operators=operators,
         )
 
@@ -226,6 +236,19 @@ def creep_spec(cfg: Config, net: Network) -> CreepSpec:
     return CreepSpec(period=None if period is None else float(period), transient=float(settings.transient),
                      slip=slip, threshold=settings.event_fraction * slip,
                      weights=(net.normal_load / net.normal_load.sum()).astype(np.float64))
+
+
+def mean_load(net: Network) -> float:
+    """f_bar = sum_i f_ext,i,x / sum_i N_i: the load along x per unit normal load (tan(incline) on an incline).
+
+    Above mu_d, an avalanche that sets every node in motion is the network
+    sliding away (docs/model.md, 'Sliding away').
+
+    >>> from slidernet.model.network import chain
+    >>> round(mean_load(chain(3, Ntilde=1e-7, normal_load=2.0, f_ext=1.1)), 12)
+    0.55
+    """
+    return float(net.f_ext[:, 0].sum() / net.normal_load.sum())
 
 
 def pair_tilt_applies(net: Network) -> bool:
@@ -254,7 +277,7 @@ def _tilt_operators(net: Network, operators: Chain | Plane) -> TiltOperators:
                        normal_load / normal_load.sum(), bool((normal_load == 1.0).all()))
     f_ext = np.zeros((N, 2))
     f_ext[:, :d] = net.f_ext
-    return TiltOperators(net=plane, f_ext=f_ext, f_bar=float(f_ext[:, 0].sum() / net.normal_load.sum()),
+    return TiltOperators(net=plane, f_ext=f_ext, f_bar=mean_load(net),
                          pair_rule=N == 2 and d == 1)
 
 
