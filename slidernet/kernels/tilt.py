@@ -83,10 +83,14 @@ def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
     return tilt_iterations(st, draws, F, mu1, mu2, mu_d, flat_onset)
 
 
-@kernel_jit()
-def tilt_sample(st, draws, out, k, F, mu1, mu2, mu_d):
-    """Run one tilt test and add its sample to output bin ``k``; returns a status."""
-    f = tilt_test_pair(st, draws, F, mu1, mu2, mu_d)
+@kernel_jit(inline="always")
+def record_tilt(f, out, k):
+    """Add a tilt test's result f to output bin ``k`` (``out.f_sum``, ``f_sq``, ``f_count``); returns a status.
+
+    ``f`` is what :func:`tilt_iterations` returns: a sample, or -1.0 / -2.0
+    (the buffers ran out / the iteration cap), which become ``NEED_TILT`` /
+    ``TILT_LIMIT`` with nothing recorded.
+    """
     if f == -1.0:
         return NEED_TILT
     if f == -2.0:
@@ -95,3 +99,9 @@ def tilt_sample(st, draws, out, k, F, mu1, mu2, mu_d):
     out.f_sq[k] += f * f
     out.f_count[k] += 1
     return DONE
+
+
+@kernel_jit()
+def tilt_sample(st, draws, out, k, F, mu1, mu2, mu_d):
+    """Run one tilt test and add its sample to output bin ``k``; returns a status."""
+    return record_tilt(tilt_test_pair(st, draws, F, mu1, mu2, mu_d), out, k)

@@ -218,6 +218,25 @@ class Realization:
                 )
             self._refill_tilt()
 
+    def refill(self, status: int) -> bool:
+        """Top up the draw buffer a kernel's ``status`` says ran out; False for any other status.
+
+        ``NEED_MU``: the thresholds get the next batch of their stream;
+        ``NEED_TILT``: the tilt test's buffers (:meth:`_refill_tilt`). Where
+        the kernel stopped never changes which values it reads next.
+        """
+        if status == kernels.NEED_MU:
+            # The batches are cut at scene.batch already: _refill's size is that batch.
+            fresh = _refill(self.buffers.mu, self.state["mu_pos"][0], lambda size: next(self._mu_batches),
+                            self.scene.batch)
+            self.buffers = self.buffers._replace(mu=fresh)
+            self.state["mu_pos"] = 0
+            return True
+        if status == kernels.NEED_TILT:
+            self._refill_tilt()
+            return True
+        return False
+
     def _refill_tilt(self) -> None:
         """Top up the tilt test's buffers after a test ran out of one of them.
 
@@ -252,10 +271,6 @@ class Realization:
         # The kernel stops at the end of the array it is given.
         thetas = self.thetas[: to_step + 1]
         st = self.state
-
-        def draw_mu(size: int) -> np.ndarray:
-            return next(self._mu_batches)  # size is always scene.batch
-
         while True:
             status = self.backend.run(self, thetas)
             if status == kernels.DONE:
@@ -265,13 +280,9 @@ class Realization:
                 # is over, at its last step for whoever advances it.
                 st["q"] = scene.steps
                 return self
-            if status == kernels.NEED_MU:
-                fresh = _refill(self.buffers.mu, st["mu_pos"][0], draw_mu, scene.batch)
-                self.buffers = self.buffers._replace(mu=fresh)
-                st["mu_pos"] = 0
-            elif status == kernels.NEED_TILT:
-                self._refill_tilt()
-            elif status == kernels.RECOMPUTE:
+            if self.refill(status):
+                continue
+            if status == kernels.RECOMPUTE:
                 self.recompute_forces()
             elif status == kernels.NEED_EVENTS:
                 self.backend.flush_events(self)

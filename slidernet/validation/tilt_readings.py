@@ -40,6 +40,7 @@ on the flat).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -48,24 +49,14 @@ import xarray as xr
 
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
-from slidernet.errors import param_error
-from slidernet.kernels import Draws, new_state
-from slidernet.kernels.state import TILT_MAX_ITER, kernel_jit
-from slidernet.kernels.tilt import tilt_iterations, tilt_test_pair
-from slidernet.plugins.distributions import TruncatedStream
-from slidernet.solver import Scene, horizontal_draws, realization_streams
+from slidernet.errors import TiltTestError, param_error
+from slidernet.kernels.state import DONE, NEED_MU, TILT_MAX_ITER, kernel_jit
+from slidernet.kernels.tilt import record_tilt, tilt_iterations, tilt_test_pair
+from slidernet.solver import Realization, Scene
 
 READINGS = ("threshold", "after", "incline", "incline_after")
 _AFTER = {"threshold": False, "after": True, "incline": False, "incline_after": True}
 _INCLINE = {"threshold": False, "after": False, "incline": True, "incline_after": True}
-
-# Return codes of the loop.
-_DONE = 0
-_NEED_MU = 1
-_NEED_TILT = 2
-_TILT_LIMIT = 3
-_BATCH = 1 << 16
-
 
 @kernel_jit(inline="always")
 def incline_onset(F, mu1, mu2):
@@ -124,21 +115,13 @@ def _test(st, draws, F, mu1, mu2, mu_d, incline):
 
 
 @kernel_jit()
-def _sample(st, draws, F, mu1, mu2, mu_d, incline, k, f_sum, f_sq, f_count):
-    """One test, its sample added to bin k; returns a loop code."""
-    f = _test(st, draws, F, mu1, mu2, mu_d, incline)
-    if f == -1.0:
-        return _NEED_TILT
-    if f == -2.0:
-        return _TILT_LIMIT
-    f_sum[k] += f
-    f_sq[k] += f * f
-    f_count[k] += 1
-    return _DONE
+def _sample(st, draws, F, mu1, mu2, mu_d, incline, k, out):
+    """One test, its sample added to bin k of ``out``; returns a kernel status."""
+    return record_tilt(_test(st, draws, F, mu1, mu2, mu_d, incline), out, k)
 
 
 @kernel_jit()
-def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, f_sum, f_sq, f_count):
+def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, out):
     """Two sliders through ``thetas``, one tilt test per rearrangement (and one at t = 0).
 
     Parameters
@@ -160,21 +143,22 @@ def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, f_sum, f_
         Test the state just after each rearrangement instead of just before.
     incline : bool
         Use :func:`tilt_test_incline` instead of the appendix's linear test.
-    f_sum, f_sq, f_count : ndarray, shape (T,)
-        Per bin: the sum of the samples, of their squares, and their number.
+    out : Series
+        ``out.f_sum``, ``f_sq``, ``f_count`` (shape (T,)): per bin, the sum of
+        the samples, of their squares, and their number.
 
     Returns
     -------
     int
-        0 at the end of ``thetas``; 1 or 2 when the thresholds or the tilt
-        draws ran out (refill and call again: nothing was lost); 3 if a test
-        did not end.
+        A kernel status: ``DONE`` at the end of ``thetas``; ``NEED_MU`` or
+        ``NEED_TILT`` when the thresholds or the tilt draws ran out (refill and
+        call again: nothing was lost); ``TILT_LIMIT`` if a test did not end.
     """
     st = state[0]
     steps = thetas.size - 1
     if st.started == 0:
-        code = _sample(st, draws, st.theta - st.u, mu[0], mu[1], mu_d, incline, 0, f_sum, f_sq, f_count)
-        if code != _DONE:
+        code = _sample(st, draws, st.theta - st.u, mu[0], mu[1], mu_d, incline, 0, out)
+        if code != DONE:
             return code
         st.started = 1
     while True:
@@ -197,7 +181,7 @@ def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, f_sum, f_
             k = bins[st.q] if st.q < steps else bins[steps - 1]
         else:
             if st.q >= steps:
-                return _DONE
+                return DONE
             a = thetas[st.q]
             b = thetas[st.q + 1]
             s = 1.0 if b > a else (-1.0 if b < a else 0.0)
@@ -219,15 +203,15 @@ def run_readings(thetas, bins, mu, state, draws, mu_d, after, incline, f_sum, f_
             theta_now = tc
             k = bins[st.q]
         if st.mu_pos >= draws.mu.size:
-            return _NEED_MU
+            return NEED_MU
         new = draws.mu[st.mu_pos]
         if after:
             m0 = new if i == 0 else mu[0]
             m1 = new if i == 1 else mu[1]
-            code = _sample(st, draws, theta_now - u_new, m0, m1, mu_d, incline, k, f_sum, f_sq, f_count)
+            code = _sample(st, draws, theta_now - u_new, m0, m1, mu_d, incline, k, out)
         else:
-            code = _sample(st, draws, F, mu[0], mu[1], mu_d, incline, k, f_sum, f_sq, f_count)
-        if code != _DONE:
+            code = _sample(st, draws, F, mu[0], mu[1], mu_d, incline, k, out)
+        if code != DONE:
             return code
         st.theta = theta_now
         st.u = u_new
@@ -246,10 +230,15 @@ def _bins(out_steps: np.ndarray, steps: int) -> np.ndarray:
 def realization_readings(scene: Scene, seed_seq: np.random.SeedSequence, reading: str) -> dict[str, np.ndarray]:
     """One realization of the two sliders with one reading of the tilt test.
 
+    The streams, draw buffers, initial state and output bins are those of
+    :class:`slidernet.solver.Realization` with this seed; only the loop that
+    advances them is this module's.
+
     Parameters
     ----------
     scene : Scene
-        A two-slider scene (its driver, thresholds, mu_d and recorded times).
+        A two-slider scene with the tilt test (its driver, thresholds, mu_d
+        and recorded times).
     seed_seq : numpy.random.SeedSequence
         The realization's seed: the same streams as ``slidernet.run``'s
         realization with this seed.
@@ -264,36 +253,17 @@ def realization_readings(scene: Scene, seed_seq: np.random.SeedSequence, reading
     """
     if reading not in READINGS:
         raise param_error("reading", "realization_readings", f"one of {READINGS}", reading)
-    rngs = realization_streams(seed_seq)
-    streams = {name: TruncatedStream(scene.distribution, rngs[name]) for name in ("thresholds", "tilt")}
-    thetas, mu, batches = horizontal_draws(scene, rngs, streams["thresholds"])
-    draws = Draws(next(batches), streams["tilt"].take(_BATCH), rngs["tilt_uniforms"].random(_BATCH))
-    state = new_state()
-    st = state.view(np.recarray)[0]
-    st.theta = thetas[0]
-    st.u = thetas[0]  # the spring at rest at theta(0)
-    T = scene.out_steps.size
-    f_sum, f_sq, f_count = np.zeros(T), np.zeros(T), np.zeros(T, np.int64)
+    real = Realization(scene, seed_seq)
     bins = _bins(scene.out_steps, scene.steps)
-    mu_d = float(scene.mu_d)
     while True:
-        code = run_readings(thetas, bins, mu, state, draws, mu_d, _AFTER[reading], _INCLINE[reading],
-                            f_sum, f_sq, f_count)
-        if code == _DONE:
+        status = run_readings(real.thetas, bins, real.mu, real.state, real.buffers, float(scene.mu_d),
+                              _AFTER[reading], _INCLINE[reading], real.series)
+        if status == DONE:
             break
-        if code == _NEED_MU:
-            draws = draws._replace(mu=np.concatenate([draws.mu[st.mu_pos:], next(batches)]))
-            st.mu_pos = 0
-        elif code == _NEED_TILT:
-            draws = draws._replace(tilt_mu=np.concatenate([draws.tilt_mu[st.tilt_mu_pos:],
-                                                           streams["tilt"].take(_BATCH)]),
-                                   tilt_u=np.concatenate([draws.tilt_u[st.tilt_u_pos:],
-                                                          rngs["tilt_uniforms"].random(_BATCH)]))
-            st.tilt_mu_pos = 0
-            st.tilt_u_pos = 0
-        else:
-            raise RuntimeError(f"A tilt test ({reading!r}) did not end within {TILT_MAX_ITER} iterations.")
-    return {"f_sum": f_sum, "f_sq": f_sq, "f_count": f_count, "n": np.int64(st.n_slips)}
+        if not real.refill(status):
+            raise TiltTestError(f"A tilt test ({reading!r}) did not end within {TILT_MAX_ITER} iterations.")
+    return {name: real.out[name] for name in ("f_sum", "f_sq", "f_count")} | {
+        "n": np.int64(real.state["n_slips"][0])}
 
 
 def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Dataset:
@@ -340,21 +310,17 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
     mu_eff = np.full((len(which), T), np.nan)
     sem = np.full((len(which), T), np.nan)
     count = np.zeros((len(which), T), np.int64)
-    n_end = np.zeros(model.realizations)
     for w, reading in enumerate(which):
         runs = [realization_readings(scene, s, reading) for s in seeds]
         tot = sum(r["f_sum"] for r in runs)
         cnt = sum(r["f_count"] for r in runs)
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # bins with fewer than 2 realizations: NaN
             mu_eff[w] = tot / cnt
             means = np.array([r["f_sum"] / r["f_count"] for r in runs])
-        good = np.isfinite(means)
-        m = good.sum(axis=0)
-        dev = np.where(good, means - np.nanmean(np.where(good, means, np.nan), axis=0), 0.0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sem[w] = np.sqrt((dev ** 2).sum(axis=0) / (m - 1) / m)
+            sem[w] = np.nanstd(means, axis=0, ddof=1) / np.sqrt(np.isfinite(means).sum(axis=0))
         count[w] = cnt
-        if w == 0:
+        if w == 0:  # the horizontal evolution is the same under every reading
             n_end = np.array([float(r["n"]) for r in runs])
     t = scene.out_steps.astype(float)
     ds = xr.Dataset(
