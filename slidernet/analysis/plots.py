@@ -594,9 +594,9 @@ def _read(path: Path) -> xr.Dataset:
 
 def _check_result(ds: xr.Dataset, source: str) -> None:
     """Refuse a dataset that is not one run of slidernet (no n over (realization, t))."""
-    if "t" not in ds.coords or "n" not in ds.data_vars or "n_mean" not in ds.data_vars:
-        missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
-                                            ("n_mean", "n_mean" in ds.data_vars)) if not there]
+    missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
+                                        ("n_mean", "n_mean" in ds.data_vars)) if not there]
+    if missing:
         has = ", ".join(sorted(map(str, ds.variables))) or "nothing"
         raise ConfigError(
             f"{source} is not a result of slidernet run: it has no {' and no '.join(map(repr, missing))} "
@@ -755,8 +755,9 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     maps = cfg is not None and "node_slips" in ds and "mu_s" in ds
     net = build_network(cfg) if maps else None
 
-    fig = figure if figure is not None else Figure()
-    if figure is None:
+    fig = figure
+    if fig is None:
+        fig = Figure()
         FigureCanvasAgg(fig)
     two_d = net is not None and net.dim == 2
     fig.set_size_inches(11.0, 12.5 if two_d else (10.5 if maps else 7.5))

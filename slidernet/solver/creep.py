@@ -172,6 +172,9 @@ def creep_record(events: dict[str, np.ndarray], complete: bool, steps: int, spec
     first = math.ceil(t0 / P * (1.0 - 1e-12)) if P is not None else C  # the first whole cycle after t0
     if P is not None:
         # Cycle c (1-based) takes the slips with time in (t_{c-1}, t_c]; cycle 1 also those at t = 0.
+        # A time stamp alone cannot tell a slip at the very end of step q - 1 from one at the very start of
+        # step q (both read q exactly), so at a cycle's end one slip may land in the neighbouring cycle
+        # compared with the recorded x_G (seen on two sliders with constant thresholds).
         cycle = np.searchsorted(ends, time, side="left")
         dx_cycle = np.bincount(cycle, weights=dx_G, minlength=C + 1)[:C]
         out["cycle_end"] = ends
