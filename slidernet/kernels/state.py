@@ -289,7 +289,9 @@ class Nodes(NamedTuple):
     mu: np.ndarray  # (N,): thresholds mu_s
     node_slips: np.ndarray  # (N,) int64: slips of each node
     avalanche_count: np.ndarray  # (N_AVALANCHE_BINS,) int64: avalanches by floor(log2 size)
-    moving: np.ndarray  # (N,) int64: the avalanche (id) in which the node last slipped; -1: none.
+    # (N,) int64, 0-length unless the scene can slide away: the avalanche (id) in which the node last
+    # slipped; -1: none.
+    moving: np.ndarray
     # Written only with Settings.slide_away.
 
 
