@@ -28,7 +28,7 @@ import math
 import sys
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import (
@@ -61,6 +61,18 @@ OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records", "events", "creep")
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    # Keys left out of a dump when None: a configuration that does not use a key added later dumps as it
+    # did before the key existed, so that the config stored with earlier results and the identity of
+    # interrupted runs (run.json) still match it.
+    _omit_if_none: ClassVar[tuple[str, ...]] = ()
+
+    @model_serializer(mode="wrap")
+    def _dump(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        data = handler(self)
+        for key in self._omit_if_none:
+            if isinstance(data, dict) and key in data and data[key] is None:
+                del data[key]
+        return data
 
 
 class PluginSpec(BaseModel):
@@ -102,6 +114,8 @@ class NetworkConfig(_Strict):
     force N_i tan(incline) along x, as its ``f_ext``; give one or the other.
     """
 
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("incline",)
+
     kind: Literal["two_slider", "chain", "square", "triangular", "irregular", "graph"] = Field(
         "two_slider", description="The network's geometry; each kind takes its own size keys (above).")
     Ntilde: PositiveFloat = Field(
@@ -137,15 +151,6 @@ class NetworkConfig(_Strict):
         if value is not None and not 0.0 <= value < 90.0:
             raise ValueError(f"must be in [0, 90) degrees. Got {value!r} instead")
         return value
-
-    @model_serializer(mode="wrap")
-    def _dump(self, handler: Any) -> dict[str, Any]:
-        # A horizontal network's dump (the config stored with a result, run.json) stays as it was
-        # before 'incline' existed, so that earlier results and interrupted runs still match it.
-        data = handler(self)
-        if self.incline is None:
-            data.pop("incline", None)
-        return data
 
     @model_validator(mode="after")
     def _params_match_kind(self) -> NetworkConfig:
@@ -417,6 +422,8 @@ class Config(_Strict):
     temperature amplitude, where they are not given.
     """
 
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep",)
+
     seed: Annotated[int, Field(ge=0)] | None = Field(
         None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
                           "(None: fresh OS entropy, stored in the result).")
@@ -457,15 +464,6 @@ class Config(_Strict):
     @classmethod
     def _units_fill(cls, data: Any) -> Any:
         return _fill_from_units(data)
-
-    @model_serializer(mode="wrap")
-    def _leave_out_no_creep(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        # A run without [creep] dumps as it did before the table existed: its stored
-        # configuration, and so the identity of its checkpoints, are unchanged.
-        data = handler(self)
-        if isinstance(data, dict) and data.get("creep", 0) is None:
-            del data["creep"]
-        return data
 
     @model_validator(mode="after")
     def _units_agree(self) -> Config:
@@ -512,12 +510,10 @@ class Config(_Strict):
             )
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
-        if self.solver.kernel == "pair" and "events" in self.observables:
-            raise ValueError("the 'events' observable (the event catalogue) needs a network kernel; "
-                             "use 'solver.kernel = \"auto\"' or '\"csr\"'")
-        if self.solver.kernel == "pair" and "creep" in self.observables:
-            raise ValueError("the 'creep' observable (computed from the event catalogue) needs a network "
-                             "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
+        for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue")):
+            if self.solver.kernel == "pair" and name in self.observables:
+                raise ValueError(f"the {name!r} observable ({what}) needs a network kernel; "
+                                 "use 'solver.kernel = \"auto\"' or '\"csr\"'")
         if self.creep is not None and "creep" not in self.observables:
             raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
                              "add \"creep\" to 'observables' or remove the table")

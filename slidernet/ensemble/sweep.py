@@ -527,14 +527,11 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarra
     t_common = times[shortest]
     scenes: dict[str, tuple[str, int, int]] = {}
     for i, c in enumerate(cfgs):
-        if "events" in c.observables:
-            raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the 'events' observable (the event "
-                              f"catalogue, whose length differs from run to run) cannot be swept; run the "
-                              f"points one by one with slidernet.run.")
-        if "creep" in c.observables:
-            raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the 'creep' observable (creep events "
-                              f"and cycles, whose numbers differ from run to run) cannot be swept; run the "
-                              f"points one by one with slidernet.run.")
+        for name, what in (("events", "the event catalogue, whose length differs from run to run"),
+                           ("creep", "creep events and cycles, whose numbers differ from run to run")):
+            if name in c.observables:
+                raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): the {name!r} observable ({what}) "
+                                  f"cannot be swept; run the points one by one with slidernet.run.")
         if not np.array_equal(times[i][:t_common.size], t_common):
             raise refuse(shortest, i, f"the points are stacked along t, so the recorded times of point {i} must "
                          f"begin with those of point {shortest} (the fewest steps); to sweep 'steps', record "
