@@ -118,3 +118,155 @@ def test_the_staircase_steps_where_the_closed_form_says():
 def test_the_theory_refuses_angles_outside_its_range(f, match):
     with pytest.raises(ConfigError, match=match):
         theory.pair_creep(1e-7, NTILDE, f, MU_S, MU_D)
+
+
+# Chains of 3 and more: the exact orbit (theory.chain_creep*) against the solver.
+#
+# The theory follows the forces slip by slip in rational arithmetic; the
+# solver finds each slip from its priority queue in floating point. At a
+# segment end two events tie and rounding decides, so every case below sits
+# inside a segment: CHAIN_CASES are checked to lie at least 1e-3 from the
+# nearest end (test_chain_cases_sit_inside_their_segments).
+CHAIN_CASES = [(3, 0.55, 0.12), (3, 0.55, 0.22), (3, 0.55, 0.26), (3, 0.55, 0.281), (3, 0.55, 0.29),
+               (3, 0.55, 0.35), (3, 0.55, 0.42), (3, 0.62, 0.22), (3, 0.9, 0.31), (3, 1.3, 0.26),
+               (4, 0.55, 0.29), (4, 0.55, 0.42), (8, 0.55, 0.455)]
+CHAIN_IDS = [f"n{n}-A{a}-f{f}" for n, a, f in CHAIN_CASES]
+
+
+def _steady_dx(n: int, A: float, f: float, cycles: int = 12) -> np.ndarray:
+    """The solver's x_G per cycle over the last half of the run, in l0."""
+    return np.diff(_run(A, f, n=n, cycles=cycles)["x_G"].values[0])[cycles // 2:]
+
+
+@pytest.mark.parametrize("n,A,f", CHAIN_CASES, ids=CHAIN_IDS)
+def test_chain_cases_sit_inside_their_segments(n, A, f):
+    ends = [s.lo for s in theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, tan_alpha=(0.01, 0.49),
+                                                      amplitude=A * NTILDE)]
+    assert min(abs(np.asarray(ends[1:]) - f)) > 1e-3
+
+
+@pytest.mark.parametrize("n,A,f", CHAIN_CASES, ids=CHAIN_IDS)
+def test_chain_steady_creep_is_the_exact_orbit(n, A, f):
+    slips, dx = theory.chain_creep(n, A * NTILDE, NTILDE, f, MU_S, MU_D)
+    measured = _steady_dx(n, A, f)
+    # The orbit repeats every one or two cycles: compare the mean over an even number of cycles.
+    np.testing.assert_allclose(measured.mean(), float(dx), rtol=1e-9, atol=1e-22)
+    n_rec = np.diff(_run(A, f, n=n, cycles=12)["n"].values[0])[6:]
+    assert n_rec.mean() == pytest.approx(float(slips), rel=1e-12)
+
+
+def test_two_slider_chain_is_the_pair_closed_form():
+    A = np.array([0.45, 0.55, 0.62, 0.9, 1.37])[:, None]
+    f = np.array([0.07, 0.13, 0.21, 0.33, 0.47])[None, :]
+    slips, dx = theory.chain_creep(2, A * NTILDE, NTILDE, f, MU_S, MU_D)
+    m, dx_pair = theory.pair_creep(A * NTILDE, NTILDE, f, MU_S, MU_D)
+    np.testing.assert_array_equal(slips, 2 * m)
+    np.testing.assert_allclose(dx, dx_pair, rtol=1e-12)
+
+
+@given(x=st.floats(0.0, 1.5), f=st.floats(0.01, 0.49))
+@settings(max_examples=100, deadline=None)
+def test_the_pair_segments_are_the_closed_form_staircase(x, f):
+    """Along the angle, two sliders' segments end exactly at pair_creep_steps and carry its m."""
+    segments = theory.chain_creep_segments(2, NTILDE, MU_S, MU_D, tan_alpha=(0.01, 0.49), amplitude=x * NTILDE)
+    steps = theory.pair_creep_steps(x * NTILDE, NTILDE, MU_S, MU_D)
+    ends = np.array([s.lo for s in segments[1:] if s.slips != segments[segments.index(s) - 1].slips])
+    np.testing.assert_allclose(ends, steps[(steps > 0.01) & (steps < 0.49)], atol=1e-12)
+    for seg in segments:
+        mid = 0.5 * (seg.lo + seg.hi)
+        assert seg.dx_lo == seg.dx_hi == pytest.approx(float(theory.pair_creep(x * NTILDE, NTILDE, mid, MU_S,
+                                                                                MU_D)[1]), rel=1e-12)
+
+
+@pytest.mark.parametrize("n", [3, 4])
+def test_segments_tile_the_range_and_hold_the_orbit(n):
+    A = 0.55
+    segments = theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, tan_alpha=(0.01, 0.49), amplitude=A * NTILDE)
+    assert segments[0].lo == pytest.approx(0.01) and segments[-1].hi == pytest.approx(0.49)
+    for a, b in itertools.pairwise(segments):
+        assert a.hi == b.lo
+    rng = np.random.default_rng(17)
+    for seg in segments:
+        for w in rng.uniform(0.05, 0.95, 3):
+            p = seg.lo + w * (seg.hi - seg.lo)
+            slips, dx = theory.chain_creep(n, A * NTILDE, NTILDE, p, MU_S, MU_D)
+            assert float(slips) == seg.slips
+            assert float(dx) == pytest.approx(seg.dx_lo + w * (seg.dx_hi - seg.dx_lo), rel=1e-9, abs=1e-20)
+
+
+@pytest.mark.parametrize("mu_s,mu_d", [(0.6, 0.5), (0.65, 0.52)], ids=["0.6-0.5", "0.65-0.52"])
+def test_three_sliders_first_creeping_segment_is_the_derived_law(mu_s, mu_d):
+    """The guide derives it: one end slips by D, the middle overshoots, the same end slips again.
+
+    The middle slider's force at rest settles at c = 4 mu_d - 2 mu_s - f and each half cycle's three
+    slips sum to 3 (mu_d - f) Ntilde: x_G advances 2 (mu_d - f) Ntilde per cycle.
+    """
+    A = 0.55
+    creeping = [s for s in theory.chain_creep_segments(3, NTILDE, mu_s, mu_d, tan_alpha=(0.01, 0.45),
+                                                       amplitude=A * NTILDE) if s.dx_lo > 0 or s.dx_hi > 0]
+    first = creeping[0]
+    assert first.slips == 6
+    np.testing.assert_allclose([first.dx_lo, first.dx_hi], [2 * (mu_d - first.lo) * NTILDE,
+                                                            2 * (mu_d - first.hi) * NTILDE], rtol=1e-12)
+    # The derivation holds while c > mu_d (the middle's overshoot hands the end more than D / 2 over
+    # threshold) and c + D > mu_s: f < 3 mu_d - 2 mu_s.
+    assert first.hi <= 3 * mu_d - 2 * mu_s + 1e-12
+
+
+@pytest.mark.parametrize("f", [0.22, 0.31])
+def test_three_sliders_creep_starts_at_the_critical_amplitude(f):
+    A_c = theory.chain_critical_amplitude(3, NTILDE, f, MU_S, MU_D, amplitude_max=1.5 * NTILDE) / NTILDE
+    assert np.all(_steady_dx(3, A_c - 0.005, f) == 0)
+    assert np.all(_steady_dx(3, A_c + 0.005, f) > 0)
+
+
+@pytest.mark.parametrize("f", [0.07, 0.2, 0.33])
+def test_two_slider_critical_amplitude_is_the_closed_form(f):
+    from_rest, _ = theory.pair_critical_amplitude(NTILDE, f, MU_S, MU_D)
+    got = theory.chain_critical_amplitude(2, NTILDE, f, MU_S, MU_D, amplitude_max=2 * NTILDE)
+    assert got == pytest.approx(from_rest, rel=1e-12)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"n_sliders": 1}, "'n_sliders' parameter of chain_creep_segments must be an integer >= 2. Got 1"),
+    ({"amplitude": (0.0, 1e-7)}, "Exactly one of 'tan_alpha' and 'amplitude'"),
+    ({"tan_alpha": (0.2, 0.1)}, "'tan_alpha' parameter of chain_creep_segments must be a range"),
+    ({"tan_alpha": (0.2, 0.6)}, "'tan_alpha' parameter of chain_creep_segments must be in"),
+], ids=["one-slider", "two-ranges", "reversed", "slides-away"])
+def test_the_segments_refuse_bad_arguments(kwargs, match):
+    args = {"n_sliders": 3, "tan_alpha": (0.1, 0.3), "amplitude": 0.55e-7} | kwargs
+    n = args.pop("n_sliders")
+    with pytest.raises(ConfigError, match=match):
+        theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, **args)
+
+
+@pytest.mark.parametrize("mu_s,mu_d", [(0.6, 0.5), (0.65, 0.52), (0.58, 0.5)],
+                         ids=["0.6-0.5", "0.65-0.52", "0.58-0.5"])
+@pytest.mark.parametrize("w", [0.05, 0.35, 0.6, 0.95])
+def test_three_sliders_closed_form_onset_is_the_exact_orbit(mu_s, mu_d, w):
+    """three_slider_onset (derived by hand in the guide) against the exact orbit, across its window."""
+    D = 2 * (mu_s - mu_d)
+    lo, hi = max(mu_s - 2 * D, mu_d / 2 - D / 4), 3 * mu_d - 2 * mu_s
+    f = lo + w * (hi - lo)
+    A_c, A_next, dx = theory.three_slider_onset(NTILDE, f, mu_s, mu_d)
+    got = theory.chain_critical_amplitude(3, NTILDE, f, mu_s, mu_d, amplitude_max=2 * NTILDE)
+    assert got == pytest.approx(A_c, rel=1e-12)
+    plateau = theory.chain_creep_segments(3, NTILDE, mu_s, mu_d, tan_alpha=f,
+                                          amplitude=(0.5 * A_c, A_next + 0.5 * D * NTILDE))
+    assert [s.slips for s in plateau[:2]] == [0, 6] and len(plateau) > 2  # the next plateau differs
+    assert plateau[1].lo == pytest.approx(A_c, rel=1e-12) and plateau[1].hi == pytest.approx(A_next, rel=1e-12)
+    assert plateau[1].dx_lo == plateau[1].dx_hi == pytest.approx(dx, rel=1e-12)
+
+
+@pytest.mark.parametrize("f", [0.19, 0.31])
+def test_three_slider_onset_refuses_angles_outside_its_window(f):
+    with pytest.raises(ConfigError, match=r"'tan_alpha' parameter of three_slider_onset must be in \(0.2"):
+        theory.three_slider_onset(NTILDE, f, MU_S, MU_D)
+
+
+def test_three_sliders_on_the_plateau_in_the_solver():
+    """Solver, constant thresholds: zero just below three_slider_onset's A_c, its velocity on the plateau."""
+    f = 0.24
+    A_c, A_next, dx = theory.three_slider_onset(NTILDE, f, MU_S, MU_D)
+    assert np.all(_steady_dx(3, 0.99 * A_c / NTILDE, f) == 0)
+    np.testing.assert_allclose(_steady_dx(3, 0.5 * (A_c + A_next) / NTILDE, f), dx, rtol=1e-9)

@@ -1,25 +1,32 @@
-"""Closed-form predictions of the two-slider model (the paper's section IV).
+"""Predictions of the model to compare simulations against: the paper's section IV and thermal creep.
 
-Everything here is a reference to compare simulations against; nothing is
-simulated. Units follow docs/model.md: lengths in l0, time in tau_th, friction
+Everything here is a reference for the solver, and shares no code with it.
+Units follow docs/model.md: lengths in l0, time in tau_th, friction
 coefficients dimensionless. ``n`` is always the number of rearrangements
 since t = 0, so the initial state holds two drawn thresholds and after ``n``
 rearrangements ``n + 2`` thresholds have been drawn in all (docs/model.md,
 section 4). The paper counts from an initial step n = 1 and therefore writes
 ``n + 1`` for the same number.
 
-Two kinds of results live side by side and the docstrings say which is which:
+Three kinds of results live side by side and the docstrings say which is which:
 
 * exact statements about the threshold sequence, which hold for every
   distribution p(mu_s) -- :func:`mu_max_cdf`, :func:`mu_max_moments`,
   :func:`harmonic`, :func:`mean_records`;
 * the paper's approximate laws -- :func:`mean_rearrangements` (eq. ``slope``),
   :func:`mu_max_leading` (eq. ``mumaxth``) and :func:`msd` (order of
-  magnitude only).
+  magnitude only);
+* thermal creep on an incline with constant thresholds: closed forms for
+  two sliders (:func:`pair_creep` and its companions) and for three sliders'
+  first plateau (:func:`three_slider_onset`), and the exact periodic orbit
+  of any chain, followed slip by slip in rational arithmetic
+  (:func:`chain_creep`, :func:`chain_creep_segments`,
+  :func:`chain_critical_amplitude`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from fractions import Fraction
@@ -32,6 +39,10 @@ from scipy import special
 from slidernet.errors import ConfigError, param_error
 
 __all__ = [
+    "CreepSegment",
+    "chain_creep",
+    "chain_creep_segments",
+    "chain_critical_amplitude",
     "harmonic",
     "mean_rearrangements",
     "mean_records",
@@ -43,6 +54,7 @@ __all__ = [
     "pair_creep_slips",
     "pair_creep_steps",
     "pair_critical_amplitude",
+    "three_slider_onset",
 ]
 
 # Probability mass left out at each end of the integration range of
@@ -736,3 +748,465 @@ def pair_critical_amplitude(Ntilde: float, tan_alpha: float, mu_s: float, mu_d: 
     _pair_creep_args(tan_alpha, mu_s, mu_d, "pair_critical_amplitude")
     nt = float(Ntilde)
     return (float(mu_s) - float(tan_alpha)) * nt, (float(mu_d) - float(tan_alpha)) * nt
+
+
+# Thermal creep of a chain of n sliders on an incline, clean friction
+#
+# Two sliders have a closed form (above); from three on, the interior
+# sliders slip with an overshoot -- an end slip hands D to its neighbour,
+# which can then sit above mu_s and slip by 2(|F| - mu_d) / 2, a length that
+# depends on f -- and the orbit has no short formula. It is still exact and
+# finite: with constant thresholds each slip is an affine map of the forces,
+# the choice of which slider slips next is a comparison of affine forms, and
+# a symmetric cycle of theta from rest settles after a cycle or two into an
+# exactly periodic sequence of slips. _chain_orbit follows that sequence in
+# rational arithmetic, with f and A / Ntilde affine in one parameter p, and
+# records every comparison it makes: the set of p where all of them go the
+# same way is an interval, on which the steady velocity is one affine
+# function of p. That is the derivation of the plateaus (of the slip
+# sequence) and of the values and ends of v on each, for any chain.
+#
+# Units as above: forces in N, theta and lengths in Ntilde (k = 1). The force
+# on slider i is F_i = f + s_i - s_{i-1}, with s_e the tension of spring e
+# (between sliders e and e + 1); theta shortens every spring's rest
+# extension by d theta; a slip of slider i by du = 2 (|F_i| - mu_d) sign(F_i)
+# / deg(i) (the solver's rule, K_ii = deg(i) k) moves s_i by -du and
+# s_{i-1} by +du.
+
+class _Affine:
+    """The exact affine form ``a + b p`` of one parameter p."""
+
+    __slots__ = ("a", "b")
+
+    def __init__(self, a: Fraction, b: Fraction = Fraction(0)) -> None:
+        self.a, self.b = a, b
+
+    def __add__(self, other: _Affine | Fraction) -> _Affine:
+        if isinstance(other, _Affine):
+            return _Affine(self.a + other.a, self.b + other.b)
+        return _Affine(self.a + other, self.b)
+
+    def __sub__(self, other: _Affine | Fraction) -> _Affine:
+        if isinstance(other, _Affine):
+            return _Affine(self.a - other.a, self.b - other.b)
+        return _Affine(self.a - other, self.b)
+
+    def __rsub__(self, other: Fraction) -> _Affine:
+        return _Affine(other - self.a, -self.b)
+
+    def __mul__(self, c: Fraction | int) -> _Affine:
+        return _Affine(self.a * c, self.b * c)
+
+    def key(self) -> tuple[Fraction, Fraction]:
+        return self.a, self.b
+
+
+class _Window:
+    """The values of p around ``p0`` where every comparison made so far comes out the same.
+
+    ``positive(e)`` answers e(p0) > 0 and narrows [lo, hi] to where e keeps
+    that sign; a form that vanishes at p0 pins the window to p0 (a tie of
+    two events: the orbit on either side differs).
+    """
+
+    def __init__(self, p0: Fraction, lo: Fraction, hi: Fraction) -> None:
+        self.p0, self.lo, self.hi = p0, lo, hi
+
+    def positive(self, e: _Affine) -> bool:
+        value = e.a + e.b * self.p0
+        if e.b != 0:
+            root = -e.a / e.b
+            if value == 0:
+                self.lo = self.hi = self.p0
+            elif (value > 0) == (e.b > 0):
+                self.lo = max(self.lo, root)
+            else:
+                self.hi = min(self.hi, root)
+        return value > 0
+
+
+def _chain_orbit(n: int, f: _Affine, x: _Affine, mu_s: Fraction, mu_d: Fraction, window: _Window,
+                 max_cycles: int) -> tuple[int, int, _Affine, int]:
+    """Follow n sliders from rest under theta / Ntilde = 0 -> x -> -x -> 0 -> ... until the cycle repeats.
+
+    Returns (period in cycles, slips per period, advance of x_G per period
+    in Ntilde l0, cycles of transient), the last two valid across ``window``.
+    """
+    zero = _Affine(Fraction(0))
+    s = [zero] * (n - 1)
+    u = [zero] * n
+    theta = zero
+    deg = [1 if i in (0, n - 1) else 2 for i in range(n)]
+
+    def force(i: int) -> _Affine:
+        F = f
+        if i < n - 1:
+            F = F + s[i]
+        if i > 0:
+            F = F - s[i - 1]
+        return F
+
+    def slip(i: int, F: _Affine, sign: int) -> None:
+        du = (F * sign - mu_d) * Fraction(2 * sign, deg[i])
+        u[i] = u[i] + du
+        if i < n - 1:
+            s[i] = s[i] - du
+        if i > 0:
+            s[i - 1] = s[i - 1] + du
+
+    def most_overloaded() -> tuple[int, _Affine, int] | None:
+        # The solver's avalanche rule: the largest |F_i| / mu_s first, ties to the lowest index.
+        best: tuple[int, _Affine, int] | None = None
+        for i in range(n):
+            F = force(i)
+            sign = 1 if window.positive(F) else -1
+            if window.positive(F * sign - mu_s) and (
+                    best is None or window.positive(F * sign - best[1] * best[2])):
+                best = (i, F, sign)
+        return best
+
+    def drive(target: _Affine) -> int:
+        nonlocal theta, s
+        d = 1 if window.positive(target - theta) else -1
+        slips = 0
+        while True:
+            # Only the two ends feel theta: a rise pushes the last slider forward
+            # and the first one back (an interior slider's two springs cancel).
+            h_best: tuple[_Affine, int, int] | None = None
+            for i, sign in ((0, -d), (n - 1, d)):
+                F = force(i)
+                h = (mu_s - F) if sign > 0 else (F + mu_s)
+                if h_best is None or window.positive(h_best[0] - h):
+                    h_best = (h, i, sign)
+            assert h_best is not None
+            h, i, sign = h_best
+            if window.positive(h - (target - theta) * d):
+                s = [e - (target - theta) for e in s]
+                theta = target
+                return slips
+            s = [e - h * d for e in s]
+            theta = theta + h * d
+            slip(i, force(i), sign)
+            slips += 1
+            while (over := most_overloaded()) is not None:
+                slip(*over)
+                slips += 1
+
+    seen: dict[tuple, int] = {}
+    x_G: list[_Affine] = []
+    slips_in: list[int] = []
+    for cycle in range(max_cycles + 1):
+        state = tuple(e.key() for e in s)
+        centre = zero
+        for ui in u:
+            centre = centre + ui
+        centre = centre * Fraction(1, n)
+        if state in seen:
+            first = seen[state]
+            return cycle - first, sum(slips_in[first:]), centre - x_G[first], first
+        seen[state] = cycle
+        x_G.append(centre)
+        slips_in.append(drive(x) + drive(zero - x) + drive(zero))
+    raise ConfigError(f"The cycle of {n} sliders did not repeat within max_cycles = {max_cycles}; "
+                      "raise max_cycles.")
+
+
+def _chain_args(n_sliders: int, mu_s: float, mu_d: float, owner: str) -> tuple[int, Fraction, Fraction]:
+    if isinstance(n_sliders, bool) or not isinstance(n_sliders, (int, np.integer)) or n_sliders < 2:
+        raise param_error("n_sliders", owner, "an integer >= 2", n_sliders)
+    if not 0.0 < float(mu_d) < float(mu_s):
+        raise param_error("mu_s", owner, f"> mu_d = {float(mu_d)!r} > 0", mu_s)
+    return int(n_sliders), Fraction(float(mu_s)), Fraction(float(mu_d))
+
+
+def _check_tan(f: float, mu_d: Fraction, owner: str) -> Fraction:
+    if not (math.isfinite(f) and 0.0 < f < float(mu_d)):
+        raise param_error("tan_alpha", owner, f"in (0, mu_d = {float(mu_d)!r})", f)
+    return Fraction(f)
+
+
+def chain_creep(n_sliders: int, amplitude: ArrayLike, Ntilde: float, tan_alpha: ArrayLike, mu_s: float,
+                mu_d: float, *, max_cycles: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """Steady creep of a chain of sliders with constant thresholds under a symmetric cycle of theta (exact).
+
+    The chain starts at rest at theta = 0; theta rises to +A, falls to -A
+    and so on (the ``sinusoidal`` driver with phase 0 and a period that is
+    a multiple of 4 tau_th). Every slider carries f = tan(alpha) downhill
+    and slips by the solver's rule (docs/model.md). The orbit is followed
+    slip by slip in rational arithmetic until the state at the start of a
+    cycle repeats; the period is one or two cycles in every case measured.
+    For two sliders this is :func:`pair_creep`.
+
+    Parameters
+    ----------
+    n_sliders : int
+        Sliders in the chain, >= 2.
+    amplitude : float or array_like
+        A, the amplitude of theta (dimensionless dilation), >= 0.
+    Ntilde : float
+        N / (k l0), > 0.
+    tan_alpha : float or array_like
+        Downhill load per unit normal load, in (0, mu_d); broadcast with ``amplitude``.
+    mu_s, mu_d : float
+        The constant threshold and the dynamic coefficient, mu_s > mu_d > 0.
+    max_cycles : int
+        Cycles to follow before giving up on a repeat.
+
+    Returns
+    -------
+    slips : numpy.ndarray of float, broadcast shape
+        Slips per cycle in the steady state (all sliders together; a mean
+        over the period when it is longer than one cycle).
+    dx : numpy.ndarray of float, broadcast shape
+        Advance of x_G per cycle in the steady state, in l0.
+
+    Notes
+    -----
+    The inputs are taken as the exact binary numbers they are. Where two
+    events tie (the ends of :func:`chain_creep_segments`), the orbit follows
+    the solver's rules in exact arithmetic (|F| = mu_s sticks; equal
+    overloads go to the lowest index), but the solver's floating-point
+    forces can break such a tie either way: compare inside a segment.
+
+    Examples
+    --------
+    Three sliders at A = 0.55 Ntilde: at tan(alpha) = 0.12 the two ends slip
+    back and forth and the chain stays put; at 0.22 and 0.26, six slips per
+    cycle advance it by 2 (mu_d - f) Ntilde (docs/guides/incline-creep.md
+    derives it):
+
+    >>> slips, dx = chain_creep(3, 0.55e-7, 1e-7, [0.12, 0.22, 0.26], 0.6, 0.5)
+    >>> slips.tolist(), [round(float(v) / 1e-7, 12) for v in dx]
+    ([4.0, 6.0, 6.0], [0.0, 0.56, 0.48])
+    """
+    owner = "chain_creep"
+    n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
+    A = _check_finite(amplitude, "amplitude", owner)
+    if (A < 0).any():
+        raise param_error("amplitude", owner, ">= 0", _first_bad(A, A < 0))
+    nt = float(_check_positive(Ntilde, "Ntilde", owner))
+    f = _check_finite(tan_alpha, "tan_alpha", owner)
+    A, f = np.broadcast_arrays(A, f)
+    slips = np.zeros(A.shape)
+    dx = np.zeros(A.shape)
+    for idx in np.ndindex(A.shape):
+        fi = _check_tan(float(f[idx]), md, owner)
+        xi = Fraction(float(A[idx]) / nt)
+        window = _Window(Fraction(0), Fraction(0), Fraction(0))
+        period, count, advance, _ = _chain_orbit(n, _Affine(fi), _Affine(xi), ms, md, window, max_cycles)
+        slips[idx] = count / period
+        dx[idx] = float(advance.a / period) * nt
+    return slips, dx
+
+
+@dataclasses.dataclass(frozen=True)
+class CreepSegment:
+    """An interval of one parameter on which a chain's steady cycle is one sequence of slips.
+
+    On it the advance of x_G per cycle is affine in the parameter:
+    ``dx = dx_lo + (p - lo) * (dx_hi - dx_lo) / (hi - lo)``.
+
+    Attributes
+    ----------
+    over : str
+        The parameter: ``"tan_alpha"`` or ``"amplitude"``.
+    lo, hi : float
+        The ends of the interval (amplitude in the units of theta); the
+        orbit at the ends themselves may belong to the neighbouring segment.
+    period : int
+        Cycles of theta per period of the steady orbit.
+    slips : float
+        Slips per cycle (all sliders), a mean over the period.
+    dx_lo, dx_hi : float
+        Advance of x_G per cycle at ``lo`` and at ``hi``, in l0 (the limits from inside).
+    """
+
+    over: str
+    lo: float
+    hi: float
+    period: int
+    slips: float
+    dx_lo: float
+    dx_hi: float
+
+
+def chain_creep_segments(n_sliders: int, Ntilde: float, mu_s: float, mu_d: float, *,
+                         tan_alpha: float | tuple[float, float], amplitude: float | tuple[float, float],
+                         resolution: float = 1e-9, max_cycles: int = 200) -> list[CreepSegment]:
+    """The plateaus of a chain's creep along tan(alpha) or along the amplitude, with their exact ends.
+
+    Exactly one of ``tan_alpha`` and ``amplitude`` is a ``(lo, hi)`` range.
+    The range is cut into the intervals on which the steady cycle (from
+    rest, as in :func:`chain_creep`) is one fixed sequence of slips; on each
+    the velocity is affine in the parameter, and the ends are the exact
+    values where two events tie. Along the amplitude the velocity is
+    constant on each interval (a staircase); along the angle, for three
+    sliders and more, it is not: an interior slider's overshoot grows with f.
+    Consecutive intervals with the same slips and the same affine velocity
+    are merged.
+
+    Parameters
+    ----------
+    n_sliders : int
+        Sliders in the chain, >= 2.
+    Ntilde : float
+        N / (k l0), > 0.
+    mu_s, mu_d : float
+        The constant threshold and the dynamic coefficient, mu_s > mu_d > 0.
+    tan_alpha, amplitude : float or (float, float)
+        The fixed value of one and the range of the other (tan(alpha) within
+        (0, mu_d); the amplitude of theta, dimensionless, >= 0).
+    resolution : float
+        Each interval is entered this far (relative to the range) past the
+        end of the previous one: a segment narrower than that can be missed.
+    max_cycles : int
+        Cycles to follow before giving up on a repeat.
+
+    Returns
+    -------
+    list of CreepSegment
+        In increasing order, covering the range.
+
+    Examples
+    --------
+    Two sliders: the staircase of :func:`pair_creep`, steps at mu_s - A / Ntilde + j D.
+
+    >>> for seg in chain_creep_segments(2, 1e-7, 0.6, 0.5, tan_alpha=(0.01, 0.49), amplitude=0.55e-7):
+    ...     print(f"{seg.lo:.3f} {seg.hi:.3f} {seg.slips:g} {seg.dx_lo / 1e-7:.3f} {seg.dx_hi / 1e-7:.3f}")
+    0.010 0.050 0 0.000 0.000
+    0.050 0.250 4 0.400 0.400
+    0.250 0.450 8 0.800 0.800
+    0.450 0.490 12 1.200 1.200
+
+    Three sliders at tan(alpha) = 0.22: no creep below a critical
+    amplitude, then a staircase in the amplitude:
+
+    >>> for seg in chain_creep_segments(3, 1e-7, 0.6, 0.5, tan_alpha=0.22, amplitude=(0.0, 0.95e-7)):
+    ...     print(f"{seg.lo / 1e-7:.2f} {seg.hi / 1e-7:.2f} {seg.slips:g} {seg.dx_lo / 1e-7:.3f}")
+    0.00 0.46 0 0.000
+    0.46 0.66 6 0.560
+    0.66 0.82 12 1.120
+    0.82 0.86 18 1.680
+    0.86 0.95 24 2.240
+    """
+    owner = "chain_creep_segments"
+    n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
+    nt = float(_check_positive(Ntilde, "Ntilde", owner))
+    ranged = [name for name, value in (("tan_alpha", tan_alpha), ("amplitude", amplitude))
+              if isinstance(value, (tuple, list))]
+    if len(ranged) != 1:
+        raise ConfigError(f"Exactly one of 'tan_alpha' and 'amplitude' of {owner} must be a (lo, hi) range. "
+                          f"Got tan_alpha={tan_alpha!r} and amplitude={amplitude!r} instead.")
+    over = ranged[0]
+    lo_f, hi_f = (float(v) for v in (tan_alpha if over == "tan_alpha" else amplitude))  # type: ignore[union-attr]
+    if not (math.isfinite(lo_f) and math.isfinite(hi_f) and lo_f < hi_f):
+        raise param_error(over, owner, "a range (lo, hi) with lo < hi", (lo_f, hi_f))
+    if not 0.0 < float(resolution) < 1.0:
+        raise param_error("resolution", owner, "in (0, 1)", resolution)
+    unit = Fraction(1)
+    if over == "tan_alpha":
+        _check_tan(lo_f, md, owner)
+        _check_tan(hi_f, md, owner)
+        A = float(_check_finite(amplitude, "amplitude", owner))  # type: ignore[arg-type]
+        if A < 0:
+            raise param_error("amplitude", owner, ">= 0", A)
+        x = _Affine(Fraction(A / nt))
+        f = _Affine(Fraction(0), Fraction(1))
+        lo, hi = Fraction(lo_f), Fraction(hi_f)
+    else:
+        if lo_f < 0:
+            raise param_error("amplitude", owner, ">= 0", lo_f)
+        f = _Affine(_check_tan(float(tan_alpha), md, owner))  # type: ignore[arg-type]
+        x = _Affine(Fraction(0), Fraction(1))
+        unit = Fraction(nt)
+        lo, hi = Fraction(lo_f / nt), Fraction(hi_f / nt)
+    step = (hi - lo) * Fraction(float(resolution))
+    # (lo, hi, period, slips, a, b): x_G advances (a + b p) Ntilde l0 per cycle on [lo, hi], exactly.
+    exact: list[tuple[Fraction, Fraction, int, Fraction, Fraction, Fraction]] = []
+    start = lo
+    while start < hi:
+        window = _Window(start + step, lo, hi)
+        period, count, advance, _ = _chain_orbit(n, f, x, ms, md, window, max_cycles)
+        end = window.hi if window.hi > start else start + step
+        seg = (start, end, period, Fraction(count, period), advance.a / period, advance.b / period)
+        if exact and exact[-1][2:] == seg[2:]:
+            seg = (exact.pop()[0], *seg[1:])
+        exact.append(seg)
+        start = end
+    return [CreepSegment(over, float(s * unit), float(e * unit), period, float(slips), float((a + b * s) * nt),
+                         float((a + b * e) * nt)) for s, e, period, slips, a, b in exact]
+
+
+def chain_critical_amplitude(n_sliders: int, Ntilde: float, tan_alpha: float, mu_s: float, mu_d: float, *,
+                             amplitude_max: float, resolution: float = 1e-9) -> float:
+    """The amplitude of theta from which a chain at rest starts to creep for good, with constant thresholds.
+
+    The lower end of the first segment of :func:`chain_creep_segments`
+    (along the amplitude, up to ``amplitude_max``) with a positive velocity;
+    below it the steady velocity is zero. For two sliders it is
+    (mu_s - f) Ntilde (:func:`pair_critical_amplitude`). NaN if the chain does
+    not creep below ``amplitude_max``.
+
+    Examples
+    --------
+    >>> round(chain_critical_amplitude(2, 1e-7, 0.2, 0.6, 0.5, amplitude_max=2e-7) / 1e-7, 12)
+    0.4
+    >>> round(chain_critical_amplitude(3, 1e-7, 0.2, 0.6, 0.5, amplitude_max=2e-7) / 1e-7, 12)
+    0.6
+    """
+    segments = chain_creep_segments(n_sliders, Ntilde, mu_s, mu_d, tan_alpha=tan_alpha,
+                                    amplitude=(0.0, float(amplitude_max)), resolution=resolution)
+    for seg in segments:
+        if seg.dx_lo > 0 or seg.dx_hi > 0:
+            return seg.lo
+    return math.nan
+
+
+def three_slider_onset(Ntilde: float, tan_alpha: float, mu_s: float, mu_d: float) -> tuple[float, float, float]:
+    """Closed form of three sliders' first creeping plateau from rest, with constant thresholds.
+
+    With f = tan(alpha) and D = 2 (mu_s - mu_d), for
+    max(mu_s - 2 D, mu_d / 2 - D / 4) < f < 3 mu_d - 2 mu_s
+    (docs/guides/incline-creep.md derives it):
+
+    * the critical amplitude from rest is A_c = (3 mu_d - mu_s - 2 f) Ntilde:
+      the first fall of theta must bring the uphill end to its threshold
+      twice, once to push the middle slider over and once more after it;
+    * from A_c up to A_c + D Ntilde each half cycle is three slips (an end
+      by D, the middle with an overshoot, the same end again) and x_G
+      advances by 2 (mu_d - f) Ntilde per cycle, whatever the amplitude.
+
+    :func:`chain_creep_segments` finds the same numbers from the exact
+    orbit, and the rest of the plateaus with them.
+
+    Parameters
+    ----------
+    Ntilde : float
+        N / (k l0), > 0.
+    tan_alpha : float
+        Downhill load per unit normal load, inside the window above.
+    mu_s, mu_d : float
+        The constant threshold and the dynamic coefficient.
+
+    Returns
+    -------
+    A_c, A_next : float
+        The amplitudes of theta where the plateau begins and ends.
+    dx : float
+        Advance of x_G per cycle on the plateau, in l0.
+
+    Examples
+    --------
+    >>> [round(v / 1e-7, 12) for v in three_slider_onset(1e-7, 0.22, 0.6, 0.5)]
+    [0.46, 0.66, 0.56]
+    """
+    owner = "three_slider_onset"
+    _chain_args(3, mu_s, mu_d, owner)
+    nt = float(_check_positive(Ntilde, "Ntilde", owner))
+    ms, md, f = float(mu_s), float(mu_d), float(tan_alpha)
+    D = 2.0 * (ms - md)
+    lo, hi = max(ms - 2.0 * D, md / 2.0 - D / 4.0), 3.0 * md - 2.0 * ms
+    if not lo < f < hi:
+        raise param_error("tan_alpha", owner, f"in ({lo!r}, {hi!r}), where the closed form holds", tan_alpha)
+    A_c = (3.0 * md - ms - 2.0 * f) * nt
+    return A_c, A_c + D * nt, 2.0 * (md - f) * nt
