@@ -10,12 +10,15 @@ reptates downhill (Blanc, Pugnaloni & Géminard, Phys. Rev. E 84, 061303,
 
 (a) the reptation velocity (x_G per cycle, in units of one slip
     2 (mu_s - mu_d) Ntilde l0) against tan(incline) for chains of 2, 3, 4 and 8
-    with constant thresholds (``constant``), with the exact staircase of
-    :func:`slidernet.analysis.theory.pair_creep` for two sliders;
-(b) the velocity against the amplitude of theta at tan(incline) = 0.2, with
-    constant thresholds (the critical amplitude from rest,
-    :func:`~slidernet.analysis.theory.pair_critical_amplitude`) and with
-    Gaussian thresholds, where creep goes on below it, irregularly;
+    with constant thresholds (``constant``), with the exact orbit of each
+    chain (:func:`slidernet.analysis.theory.chain_creep_segments`): a
+    staircase for two sliders, straight segments whose slopes change sign
+    for three and more;
+(b) the velocity against the amplitude of theta at tan(incline) = 0.22, with
+    constant thresholds (the exact staircases and critical amplitudes of
+    chains of 2 and 3,
+    :func:`~slidernet.analysis.theory.chain_critical_amplitude`) and with
+    Gaussian thresholds, where creep goes on below them, irregularly;
 (c) an irregular (Delaunay) network with Gaussian thresholds just above the
     amplitude where its creep stops, and further up: the waiting times
     between creep events (the ``creep`` observable: avalanches that advance
@@ -60,7 +63,10 @@ SIGMA_MU = 0.01       # the Gaussian thresholds' spread
 NTILDE = 1e-7
 PERIOD = 20           # tau_th per temperature cycle: a multiple of 4, the sampled sine reaches +-A
 SLIP = 2 * (MU_S - MU_D) * NTILDE  # one slip of an end slider, in l0
-TAN_B = 0.2           # tan(incline) of panels (b) to (d)
+# tan(incline) of panel (b): inside a segment of the chain of 3's exact orbit. At 0.2 two events tie
+# for every amplitude (f = D), and the solver's rounding decides the orbit.
+TAN_B = 0.22
+TAN_NET = 0.2         # tan(incline) of panels (c) and (d), the irregular network
 # (A / Ntilde, share of the preset's wait_cycles) of panel (c): near where the network stops creeping, and above
 # (where events are frequent, fewer cycles keep the event catalogue below solver.max_events).
 WAIT_RUNS = ((0.06, 1.0), (0.13, 0.2))
@@ -135,26 +141,35 @@ def _degrees(tan_alpha: float) -> float:
     return math.degrees(math.atan(tan_alpha))
 
 
+def _segments(n: int, **range_and_value: Any) -> list[dict[str, float]]:
+    """The exact orbit's segments, velocities in slips per cycle."""
+    segs = theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, **range_and_value)
+    return [{"lo": s.lo, "hi": s.hi, "v_lo": s.dx_lo / SLIP, "v_hi": s.dx_hi / SLIP, "slips": s.slips,
+             "period": s.period} for s in segs]
+
+
 def panel_a(p: Preset) -> dict[str, Any]:
-    tans = np.linspace(0.01, 0.49, p.angles)
+    # The grid is offset by 0.001 from round values: the segments of the exact orbit end at round
+    # values (0.05, 0.2, 0.275, ...), where two events tie and rounding decides.
+    tans = np.linspace(0.011, 0.491, p.angles)
     A = 0.55
-    out: dict[str, Any] = {"A_over_Ntilde": A, "tan_alpha": tans.tolist(), "v": {}}
+    out: dict[str, Any] = {"A_over_Ntilde": A, "tan_alpha": tans.tolist(), "v": {}, "theory": {},
+                           "theory_at_points": {}}
     for n in (2, 3, 4, 8):
         out["v"][str(n)] = [velocity(slidernet.run(make_config({"kind": "chain", "n": n}, _degrees(t),
                                                                A * NTILDE, p.cycles, gaussian=False),
                                                    progress=False))[0] for t in tans]
-    fine = np.linspace(0.01, 0.49, 481)
-    out["theory_2"] = {"tan_alpha": fine.tolist(),
-                       "v": (theory.pair_creep(A * NTILDE, NTILDE, fine, MU_S, MU_D)[1] / SLIP).tolist(),
-                       "steps": theory.pair_creep_steps(A * NTILDE, NTILDE, MU_S, MU_D).tolist()}
+        out["theory"][str(n)] = _segments(n, tan_alpha=(0.01, 0.49), amplitude=A * NTILDE)
+        out["theory_at_points"][str(n)] = (theory.chain_creep(n, A * NTILDE, NTILDE, tans, MU_S, MU_D)[1]
+                                           / SLIP).tolist()
     return out
 
 
-def _amplitude_sweep(network: dict[str, Any], p: Preset, amps: np.ndarray, gaussian: bool,
-                     seed: int) -> tuple[list[float], list[float]]:
+def _amplitude_sweep(network: dict[str, Any], p: Preset, amps: np.ndarray, gaussian: bool, seed: int,
+                     tan_alpha: float) -> tuple[list[float], list[float]]:
     vs, es = [], []
     for k, a in enumerate(amps):
-        cfg = make_config(network, _degrees(TAN_B), a * NTILDE, p.cycles, gaussian=gaussian,
+        cfg = make_config(network, _degrees(tan_alpha), a * NTILDE, p.cycles, gaussian=gaussian,
                           realizations=p.realizations if gaussian else 1, seed=seed + k)
         v, e = velocity(slidernet.run(cfg, progress=False))
         vs.append(v)
@@ -164,15 +179,19 @@ def _amplitude_sweep(network: dict[str, Any], p: Preset, amps: np.ndarray, gauss
 
 def panel_b(p: Preset) -> dict[str, Any]:
     amps = np.linspace(0.2, 0.7, p.amplitudes)
-    from_rest, any_state = theory.pair_critical_amplitude(NTILDE, TAN_B, MU_S, MU_D)
-    out: dict[str, Any] = {"A_over_Ntilde": amps.tolist(), "A_c_from_rest": from_rest / NTILDE,
-                           "A_c_any_state": any_state / NTILDE, "runs": {}}
+    _, any_state = theory.pair_critical_amplitude(NTILDE, TAN_B, MU_S, MU_D)
+    out: dict[str, Any] = {"A_over_Ntilde": amps.tolist(), "A_c_any_state_2": any_state / NTILDE, "runs": {},
+                           "A_c": {}, "theory": {}}
     for n in (2, 3):
         for gaussian in (False, True):
             key = f"{n}-{'gaussian' if gaussian else 'constant'}"
-            v, e = _amplitude_sweep({"kind": "chain", "n": n}, p, amps, gaussian, seed=100 * n)
+            v, e = _amplitude_sweep({"kind": "chain", "n": n}, p, amps, gaussian, seed=100 * n, tan_alpha=TAN_B)
             out["runs"][key] = {"v": v, "sem": e}
-    out["theory_2"] = (theory.pair_creep(amps * NTILDE, NTILDE, TAN_B, MU_S, MU_D)[1] / SLIP).tolist()
+        out["A_c"][str(n)] = theory.chain_critical_amplitude(n, NTILDE, TAN_B, MU_S, MU_D,
+                                                             amplitude_max=amps[-1] * NTILDE) / NTILDE
+        out["theory"][str(n)] = _segments(n, tan_alpha=TAN_B, amplitude=(amps[0] * NTILDE, amps[-1] * NTILDE))
+        for seg in out["theory"][str(n)]:
+            seg["lo"], seg["hi"] = seg["lo"] / NTILDE, seg["hi"] / NTILDE
     return out
 
 
@@ -190,7 +209,7 @@ def panel_c(p: Preset, seed: int = 8) -> dict[str, Any]:
     for A, share in WAIT_RUNS:
         cycles = int(share * p.wait_cycles)
         net = {"kind": "irregular", "n": p.nodes, "seed": 3}
-        cfg = make_config(net, _degrees(TAN_B), A * NTILDE, cycles, gaussian=True, seed=seed)
+        cfg = make_config(net, _degrees(TAN_NET), A * NTILDE, cycles, gaussian=True, seed=seed)
         cfg["observables"] = ["n", "x_G", "creep"]
         cfg["creep"] = {"event_fraction": 0.5 / p.nodes}
         ds = slidernet.run(cfg, progress=False)
@@ -211,8 +230,18 @@ def panel_c(p: Preset, seed: int = 8) -> dict[str, Any]:
 def panel_d(p: Preset) -> dict[str, Any]:
     amps = np.linspace(0.02, 0.7, p.amplitudes)
     net = {"kind": "irregular", "n": p.nodes, "seed": 3}
-    v, e = _amplitude_sweep(net, p, amps, gaussian=True, seed=900)
+    v, e = _amplitude_sweep(net, p, amps, gaussian=True, seed=900, tan_alpha=TAN_NET)
     return {"A_over_Ntilde": amps.tolist(), "nodes": p.nodes, "v": v, "sem": e}
+
+
+def _plot_segments(axis: Any, segments: list[dict[str, float]], colour: str, label: str | None) -> None:
+    """One straight line per segment, broken where the orbit changes."""
+    xs: list[float] = []
+    ys: list[float] = []
+    for seg in segments:
+        xs += [seg["lo"], seg["hi"], math.nan]
+        ys += [seg["v_lo"], seg["v_hi"], math.nan]
+    axis.plot(xs, ys, "-", color=colour, lw=1, label=label)
 
 
 def plot(data: dict[str, Any], path: Path) -> Path:
@@ -222,8 +251,8 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     a = data["a"]
     for n, c in zip(("2", "3", "4", "8"), ("C0", "C1", "C2", "C3"), strict=True):
         ax.plot(a["tan_alpha"], a["v"][n], "o", ms=4, mfc="none", color=c, label=f"chain of {n}")
-    th = a["theory_2"]
-    ax.plot(th["tan_alpha"], th["v"], "-", color="C0", lw=1, label="theory, 2 sliders (pair_creep)")
+    for n, c in zip(("2", "3", "4", "8"), ("C0", "C1", "C2", "C3"), strict=True):
+        _plot_segments(ax, a["theory"][n], c, label="exact orbit (chain_creep_segments)" if n == "2" else None)
     ax.set_xlabel(r"$\tan\alpha$ (downhill load per unit normal load)")
     ax.set_ylabel("x_G per cycle (slips)")
     ax.set_title(rf"(a) constant $\mu_s = {MU_S}$, $\mu_d = {MU_D}$, $A = {a['A_over_Ntilde']}\,\tilde N$",
@@ -237,10 +266,11 @@ def plot(data: dict[str, Any], path: Path) -> Path:
         bx.errorbar(b["A_over_Ntilde"], run["v"], yerr=run["sem"], fmt=m, ms=4, mfc="none", color=c,
                     capsize=2, label=key.replace("-", " sliders, ").replace("gaussian",
                                                                            rf"Gaussian $\sigma_\mu={SIGMA_MU}$"))
-    bx.plot(b["A_over_Ntilde"], b["theory_2"], "-", color="C0", lw=1, label="theory, 2 sliders")
-    bx.axvline(b["A_c_from_rest"], color="0.4", ls="--", lw=1,
-               label=r"$A_c$ from rest, $(\mu_s - \tan\alpha)\tilde N$")
-    bx.axvline(b["A_c_any_state"], color="0.4", ls=":", lw=1, label=r"$(\mu_d - \tan\alpha)\tilde N$")
+    for n, c in (("2", "C0"), ("3", "C1")):
+        _plot_segments(bx, b["theory"][n], c, label=f"exact orbit, {n} sliders")
+        bx.axvline(b["A_c"][n], color=c, ls="--", lw=1, label=rf"$A_c$ from rest, {n} sliders")
+    bx.axvline(b["A_c_any_state_2"], color="0.4", ls=":", lw=1,
+               label=r"$(\mu_d - \tan\alpha)\tilde N$ (2 sliders, any state)")
     bx.set_xlabel(r"$A/\tilde N$ (amplitude of $\theta$)")
     bx.set_ylabel("x_G per cycle (slips)")
     bx.set_title(rf"(b) $\tan\alpha = {TAN_B}$", fontsize=10)
@@ -258,14 +288,14 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     cx.set_xscale("log")
     cx.set_xlabel(r"waiting time between creep events ($\tau_\mathrm{th}$)")
     cx.set_ylabel("P(wait > w); lines: exponential of the same mean")
-    cx.set_title(rf"(c) irregular network, {c['nodes']} nodes, Gaussian, $\tan\alpha = {TAN_B}$ "
+    cx.set_title(rf"(c) irregular network, {c['nodes']} nodes, Gaussian, $\tan\alpha = {TAN_NET}$ "
                  f"(seed {c['seed']})", fontsize=10)
     cx.legend(fontsize=8)
     d = data["d"]
     dx.errorbar(d["A_over_Ntilde"], d["v"], yerr=d["sem"], fmt="s", ms=4, mfc="none", color="C4", capsize=2)
     dx.set_xlabel(r"$A/\tilde N$")
     dx.set_ylabel("x_G per cycle (slips)")
-    dx.set_title(rf"(d) irregular network, {d['nodes']} nodes, Gaussian, $\tan\alpha = {TAN_B}$", fontsize=10)
+    dx.set_title(rf"(d) irregular network, {d['nodes']} nodes, Gaussian, $\tan\alpha = {TAN_NET}$", fontsize=10)
     for axis in (ax, bx, dx):
         axis.grid(alpha=0.3)
     return save_figure(fig, path, dpi=120)

@@ -100,7 +100,7 @@ def test_chain_aging_quick(tmp_path):
 
 
 def test_incline_creep_quick(tmp_path):
-    """The --quick preset (seeds fixed in the script): the pair's staircase is the theory's; no creep below A_c."""
+    """The --quick preset (seeds fixed in the script): every chain follows its exact orbit; no creep below A_c."""
     import json
 
     import numpy as np
@@ -111,10 +111,14 @@ def test_incline_creep_quick(tmp_path):
     assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
     data = json.loads((tmp_path / "incline_creep.json").read_text())
     a = data["a"]
-    theory_at_points = np.interp(a["tan_alpha"], a["theory_2"]["tan_alpha"], a["theory_2"]["v"])
-    off_steps = [min(abs(t - s) for s in a["theory_2"]["steps"]) > 0.01 for t in a["tan_alpha"]]
-    np.testing.assert_allclose(np.asarray(a["v"]["2"])[off_steps], theory_at_points[off_steps], atol=1e-9)
+    for n in ("2", "3", "4", "8"):
+        # The grid avoids the segments' ends, where rounding decides: the solver is the exact orbit.
+        ends = np.array([s["lo"] for s in a["theory"][n][1:]])
+        assert min(np.min(abs(ends - t)) for t in a["tan_alpha"]) > 5e-4
+        np.testing.assert_allclose(a["v"][n], a["theory_at_points"][n], rtol=1e-9, atol=1e-9)
     b = data["b"]
-    below = np.asarray(b["A_over_Ntilde"]) < b["A_c_from_rest"]
-    assert (np.asarray(b["runs"]["2-constant"]["v"])[below] == 0).all()
-    assert (np.asarray(b["runs"]["2-constant"]["v"])[~below] > 0).all()
+    for n in ("2", "3"):
+        v = np.asarray(b["runs"][f"{n}-constant"]["v"])
+        below = np.asarray(b["A_over_Ntilde"]) < b["A_c"][n]
+        assert below.any() and (~below).any()
+        assert (v[below] == 0).all() and (v[~below] > 0).all()

@@ -964,7 +964,7 @@ def chain_creep(n_sliders: int, amplitude: ArrayLike, Ntilde: float, tan_alpha: 
     -----
     The inputs are taken as the exact binary numbers they are. Where two
     events tie (the ends of :func:`chain_creep_segments`), the orbit follows
-    the solver's rules in exact arithmetic (|F| = mu_s sticks; equal
+    the solver's rules in exact arithmetic (``|F| = mu_s`` sticks; equal
     overloads go to the lowest index), but the solver's floating-point
     forces can break such a tie either way: compare inside a segment.
 
@@ -1125,6 +1125,10 @@ def chain_creep_segments(n_sliders: int, Ntilde: float, mu_s: float, mu_d: float
     exact: list[tuple[Fraction, Fraction, int, Fraction, Fraction, Fraction]] = []
     start = lo
     while start < hi:
+        if exact and hi - start < step:
+            # A sliver narrower than the resolution at the range's end: the last segment takes it.
+            exact[-1] = (*exact[-1][:1], hi, *exact[-1][2:])
+            break
         window = _Window(start + step, lo, hi)
         period, count, advance, _ = _chain_orbit(n, f, x, ms, md, window, max_cycles)
         end = window.hi if window.hi > start else start + step
