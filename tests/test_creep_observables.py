@@ -185,10 +185,13 @@ def test_a_realization_without_creep_keeps_its_records():
 
 @st.composite
 def catalogues(draw):
-    """A catalogue of avalanches in [0, steps]: ids in order, several slips each, times non-decreasing."""
+    """A catalogue of avalanches in [0, steps): ids in order, several slips each, times non-decreasing.
+
+    The kernels stamp the events of step q in [q, q + 1), so no stamp reaches ``steps``.
+    """
     steps = draw(st.integers(10, 60))
     n_av = draw(st.integers(0, 30))
-    times = sorted(draw(st.lists(st.floats(0, steps), min_size=n_av, max_size=n_av)))
+    times = sorted(draw(st.lists(st.floats(0, steps, exclude_max=True), min_size=n_av, max_size=n_av)))
     sizes = draw(st.lists(st.integers(1, 3), min_size=n_av, max_size=n_av))
     rows = [(t, a + 1, draw(st.integers(0, 2)), draw(st.sampled_from([-2.0, 1.0, 2.0, 3.0])))
             for a, (t, s) in enumerate(zip(times, sizes, strict=True)) for _ in range(s)]
@@ -211,11 +214,11 @@ def test_the_reduction_keeps_its_invariants(catalogue, period, transient, fracti
     if period is not None:
         C = rec["dx_G_cycle"].size
         assert C == int(steps // period)
-        inside = ev["time"] <= C * period
+        inside = ev["time"] < C * period
         assert rec["dx_G_cycle"].sum() == pytest.approx((w[ev["node"]] * ev["dx"])[inside].sum(), abs=1e-9)
         np.testing.assert_allclose(rec["x_G_cycle"], np.cumsum(rec["dx_G_cycle"]))
     else:
-        after = ev["time"] > transient
+        after = ev["time"] >= transient
         rate = (w[ev["node"]] * ev["dx"])[after].sum() / (steps - transient)
         assert float(rec["v_creep"]) == pytest.approx(rate, abs=1e-9)
 
@@ -225,3 +228,20 @@ def test_an_incomplete_catalogue_reduces_to_nan():
     ev = {"time": np.array([1.0]), "avalanche": np.array([1]), "node": np.array([0]), "dx": np.array([1.0])}
     rec = creep_record(ev, False, 20, spec)
     assert np.isnan(rec["v_creep"]) and np.isnan(rec["x_G_cycle"]).all() and rec["creep_events"]["time"].size == 0
+
+
+def test_a_slip_at_a_cycle_end_falls_in_the_cycle_the_recorded_x_G_puts_it():
+    """Two sliders at tan = 0.2, A = 0.617 Ntilde: slider 1 yields exactly at theta = 0, a cycle's end.
+
+    U = mu_s - f = 2 D, and G stays congruent to theta modulo D, so the slips land on the samples
+    theta(t_c) = 0 themselves. The kernels stamp a step's events in [q, q + 1): each cycle's advance
+    from the catalogue is the difference of the recorded x_G, slip for slip.
+    """
+    steps = 800
+    cfg = creep_config(amplitude=0.617 * NTILDE, steps=steps, observables=("n", "x_G", "creep", "events"),
+                       record=list(range(0, steps + 1, 20)))
+    cfg["network"] = {"kind": "chain", "n": 2, "Ntilde": NTILDE, "incline": math.degrees(math.atan(0.2))}
+    ds = slidernet.run(cfg, progress=False)
+    times = ds["event_time"].values
+    assert (times == np.round(times)).any(), "no slip at a sample: the scene no longer tests the boundary"
+    np.testing.assert_allclose(ds["dx_G_cycle"].values[0], np.diff(ds["x_G"].values[0]), rtol=1e-12, atol=0)

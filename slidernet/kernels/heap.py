@@ -407,12 +407,20 @@ def theta_direction(st, thetas):
 
 @kernel_jit(inline="always")
 def open_driving_event(st, thetas, thc):
-    """Start the avalanche of a driving event at theta_c: count it, and stamp its time (q + fraction)."""
+    """Start the avalanche of a driving event at theta_c: count it, and stamp its time (q + fraction).
+
+    The stamps of step q lie in [q, q + 1): an event at theta(t_{q+1}) itself
+    comes before the output at q + 1, and a stamp of exactly q + 1 would
+    read as one after it (an event at theta(t_{q+1}) found in step q + 1, or
+    a fraction below q's ulp, also reads q + 1). Periodic drivers with
+    constant thresholds put events exactly there.
+    """
     q = st.q
     st.av_slips = 0
     st.in_avalanche = 1
     st.n_events += 1
-    st.event_time = q + (thc - thetas[q]) / (thetas[q + 1] - thetas[q])
+    time = q + (thc - thetas[q]) / (thetas[q + 1] - thetas[q])
+    st.event_time = time if time < q + 1.0 else math.nextafter(q + 1.0, q)
 
 
 @kernel_jit(inline="always")

@@ -7,8 +7,9 @@ time, not only at the recorded ones:
 
 - per cycle of a periodic driver (period P, in tau_th): x_G at the ends of
   the whole cycles t_c = c P, c = 1 … C = floor(steps / P), and its advance
-  over each cycle (the slips with time in (t_{c-1}, t_c]; cycle 1 also takes
-  the relaxation at t = 0);
+  over each cycle (the slips with time in [t_{c-1}, t_c): the kernels stamp
+  the events of step q in [q, q + 1), so these are the slips between the
+  outputs at t_{c-1} and t_c, and cycle 1 takes the relaxation at t = 0);
 - the reptation velocity after the transient t_0: with a period, the mean
   advance per cycle over the whole cycles that start at or after t_0
   (``v_creep_cycle``, l0 per cycle) divided by P (``v_creep``, l0 per
@@ -171,11 +172,9 @@ def creep_record(events: dict[str, np.ndarray], complete: bool, steps: int, spec
     t0 = spec.transient
     first = math.ceil(t0 / P * (1.0 - 1e-12)) if P is not None else C  # the first whole cycle after t0
     if P is not None:
-        # Cycle c (1-based) takes the slips with time in (t_{c-1}, t_c]; cycle 1 also those at t = 0.
-        # A time stamp alone cannot tell a slip at the very end of step q - 1 from one at the very start of
-        # step q (both read q exactly), so at a cycle's end one slip may land in the neighbouring cycle
-        # compared with the recorded x_G (seen on two sliders with constant thresholds).
-        cycle = np.searchsorted(ends, time, side="left")
+        # Cycle c (1-based) takes the slips with time in [t_{c-1}, t_c): the kernels stamp the events of
+        # step q in [q, q + 1), so these are exactly the slips between the outputs at t_{c-1} and t_c.
+        cycle = np.searchsorted(ends, time, side="right")
         dx_cycle = np.bincount(cycle, weights=dx_G, minlength=C + 1)[:C]
         out["cycle_end"] = ends
         out["x_G_cycle"] = np.cumsum(dx_cycle)
@@ -188,7 +187,7 @@ def creep_record(events: dict[str, np.ndarray], complete: bool, steps: int, spec
         sem = kept.std(ddof=1) / math.sqrt(kept.size) / P if kept.size > 1 else np.nan
         out["v_creep_cycles_sem"] = np.float64(sem)
     else:
-        after = (time > t0) & (time <= steps)
+        after = time >= t0
         out["v_creep"] = np.float64(dx_G[after].sum() / (steps - t0))
         out["v_creep_cycle"] = np.float64(np.nan)
         out["v_creep_cycles_sem"] = np.float64(np.nan)
