@@ -768,10 +768,10 @@ def pair_critical_amplitude(Ntilde: float, tan_alpha: float, mu_s: float, mu_d: 
 #
 # Units as above: forces in N, theta and lengths in Ntilde (k = 1). The force
 # on slider i is F_i = f + s_i - s_{i-1}, with s_e the tension of spring e
-# (between sliders e and e + 1); theta shortens every spring's rest
-# extension by d theta; a slip of slider i by du = 2 (|F_i| - mu_d) sign(F_i)
-# / deg(i) (the solver's rule, K_ii = deg(i) k) moves s_i by -du and
-# s_{i-1} by +du.
+# (between sliders e and e + 1); a rise of theta by d theta lengthens every
+# rest length and so lowers every tension by d theta; a slip of slider i by
+# du = 2 (|F_i| - mu_d) sign(F_i) / deg(i) (the solver's rule, K_ii =
+# deg(i) k) moves s_i by -du and s_{i-1} by +du.
 
 class _Affine:
     """The exact affine form ``a + b p`` of one parameter p."""
