@@ -35,6 +35,11 @@ class CheckpointError(SlidernetError, ValueError):
     """A checkpoint file is unreadable, or belongs to another run or scene."""
 
 
+class ResultError(SlidernetError, ValueError):
+    """A result file or dataset cannot be read, or lacks what is asked of it (not a run of slidernet,
+    a sweep where one run is wanted, no per-node variables for a network picture)."""
+
+
 class OutputError(SlidernetError, OSError):
     """An output path cannot be used (a file where a folder is wanted, no permission, no such parent),
     or it holds a finished result that would be replaced without ``overwrite``."""

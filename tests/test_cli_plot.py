@@ -17,7 +17,7 @@ from slidernet.analysis import theory
 from slidernet.analysis.plots import plot_result, theory_overlays
 from slidernet.cli import main
 from slidernet.config import load_config
-from slidernet.errors import ConfigError
+from slidernet.errors import ResultError
 from slidernet.io import read_result, result_config, write_netcdf
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -203,7 +203,7 @@ def test_not_a_slidernet_result(tmp_path, capsys):
 def test_a_sweep_is_refused(results):
     ds = read_result(results["pair"])
     swept = xr.concat([ds, ds], dim="sigma_theta")
-    with pytest.raises(ConfigError, match=r"more than one run: its 'n' has dims .*\['sigma_theta'\].*isel"):
+    with pytest.raises(ResultError, match=r"more than one run: its 'n' has dims .*\['sigma_theta'\].*isel"):
         plot_result(swept)
 
 

@@ -22,7 +22,7 @@ from slidernet.analysis.plots import (
     slip_map,
 )
 from slidernet.config import load_config
-from slidernet.errors import ConfigError
+from slidernet.errors import ConfigError, ResultError
 from slidernet.io import read_result, write_netcdf
 from slidernet.model.builders import triangular
 from slidernet.model.network import chain
@@ -198,7 +198,7 @@ def test_two_slider_result_has_no_per_node_fields(pair_ds, draw, name):
 
 
 def test_two_slider_result_writes_no_picture(pair_ds, tmp_path):
-    with pytest.raises(ConfigError, match="no 'node_slips' variable"):
+    with pytest.raises(ResultError, match="no 'node_slips' variable"):
         save_network_pictures(pair_ds, tmp_path / "pics")
     assert not (tmp_path / "pics").exists()
 

@@ -48,7 +48,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from slidernet.analysis import theory
-from slidernet.errors import ConfigError, SlidernetError
+from slidernet.errors import ConfigError, ResultError, SlidernetError
 from slidernet.io import read_result, result_config, save_figure
 
 if TYPE_CHECKING:
@@ -236,7 +236,7 @@ def network_of(ds: xr.Dataset) -> Network:
 def _node_values(ds: xr.Dataset, name: str, what: str, realization: int) -> np.ndarray:
     """The row of a per-node variable for one realization, with the errors a user can act on."""
     if name not in ds.data_vars:
-        raise ConfigError(
+        raise ResultError(
             f"The dataset has no {name!r} variable: {what} need a network scene (kernel 'csr' or "
             f"'vec'); this result was made by kernel {ds.attrs.get('kernel', 'unknown')!r}."
         )
@@ -326,10 +326,12 @@ def slip_map(ds: xr.Dataset, realization: int = 0, ax: Axes | None = None, netwo
 
     Raises
     ------
-    ConfigError
+    ResultError
         The dataset has no ``node_slips`` (e.g. the two-slider scene, kernel
-        ``pair``), ``realization`` is out of range, or ``network`` has another
-        number of nodes.
+        ``pair``).
+    ConfigError
+        ``realization`` is out of range, or ``network`` has another number of
+        nodes.
     """
     return _field_figure(ds, "node_slips", "slip maps", realization, ax, network, cmap="magma", log=log,
                          label="slips per node over the run (count)")
@@ -356,10 +358,12 @@ def mu_s_field(ds: xr.Dataset, realization: int = 0, ax: Axes | None = None,
 
     Raises
     ------
-    ConfigError
+    ResultError
         The dataset has no ``mu_s`` (e.g. the two-slider scene, kernel
-        ``pair``), ``realization`` is out of range, or ``network`` has another
-        number of nodes.
+        ``pair``).
+    ConfigError
+        ``realization`` is out of range, or ``network`` has another number of
+        nodes.
     """
     return _field_figure(ds, "mu_s", "threshold maps", realization, ax, network, cmap="viridis",
                          label=r"static threshold $\mu_s$ at the end (dimensionless)")
@@ -387,7 +391,7 @@ def save_network_pictures(ds: xr.Dataset, out_dir: str | os.PathLike[str], *, dp
 
     Raises
     ------
-    ConfigError
+    ResultError, ConfigError
         As :func:`slip_map`, before any file is written.
     """
     # Both checks first, so a two-slider result leaves no file behind.
@@ -579,16 +583,16 @@ TIME_PANELS = (
 
 
 def _read(path: Path) -> xr.Dataset:
-    """A result file read into memory, or a ConfigError that names the file and what is wrong."""
+    """A result file read into memory, or a ResultError that names the file and what is wrong."""
     if not path.exists():
-        raise ConfigError(f"The result file {str(path)!r} does not exist.")
+        raise ResultError(f"The result file {str(path)!r} does not exist.")
     if not path.is_file():
-        raise ConfigError(f"The result file {str(path)!r} is not a file (a result is the result.nc of "
+        raise ResultError(f"The result file {str(path)!r} is not a file (a result is the result.nc of "
                           "`slidernet run`).")
     try:
         return read_result(path)
     except (OSError, ValueError) as exc:
-        raise ConfigError(f"The file {str(path)!r} is not a readable netCDF file: "
+        raise ResultError(f"The file {str(path)!r} is not a readable netCDF file: "
                           f"{getattr(exc, 'strerror', None) or exc}.") from None
 
 
@@ -598,14 +602,14 @@ def _check_result(ds: xr.Dataset, source: str) -> None:
                                         ("n_mean", "n_mean" in ds.data_vars)) if not there]
     if missing:
         has = ", ".join(sorted(map(str, ds.variables))) or "nothing"
-        raise ConfigError(
+        raise ResultError(
             f"{source} is not a result of slidernet run: it has no {' and no '.join(map(repr, missing))} "
             f"(the time t in tau_th, the rearrangements n over (realization, t) and their ensemble mean). "
             f"It holds: {has}."
         )
     if ds["n"].dims != ("realization", "t"):
         extra = [d for d in ds["n"].dims if d not in ("realization", "t")]
-        raise ConfigError(
+        raise ResultError(
             f"{source} holds more than one run: its 'n' has dims {ds['n'].dims}, with {extra} besides "
             "(realization, t), as a sweep has. Plot one point: select it, e.g. ds.isel("
             f"{extra[0]}=0), and pass that dataset to slidernet.analysis.plots.plot_result."
@@ -712,11 +716,13 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
 
     Raises
     ------
-    ConfigError
+    ResultError
         Before anything is drawn or written: the file is missing or not
         netCDF; the dataset has no ``t``, ``n`` or ``n_mean`` (not a result
-        of ``slidernet run``) or holds several runs (a sweep); ``path`` has a
-        suffix matplotlib cannot write.
+        of ``slidernet run``) or holds several runs (a sweep).
+    ConfigError
+        Before anything is drawn or written: ``path`` has a suffix
+        matplotlib cannot write.
 
     Examples
     --------
