@@ -31,6 +31,11 @@ class TiltTestError(SlidernetError, RuntimeError):
     """The virtual tilt test did not reach a sliding state within its iteration cap."""
 
 
+class OrbitError(SlidernetError, RuntimeError):
+    """An exact creep orbit of the theory did not repeat within its cycle cap: from four sliders on,
+    some orbits are aperiodic."""
+
+
 class CheckpointError(SlidernetError, ValueError):
     """A checkpoint file is unreadable, or belongs to another run or scene."""
 
