@@ -968,9 +968,12 @@ def chain_orbit(n_sliders: int, amplitude: float, Ntilde: float, tan_alpha: floa
     """The steady creep orbit of a chain with constant thresholds at one point: period, transient, velocity.
 
     As :func:`chain_creep` at one (amplitude, tan_alpha), with the orbit's
-    period and transient. For two and three sliders the orbit repeats
-    after at most one cycle, with a period of one cycle (300 random
-    parameter sets of three sliders, ``benchmarks/creep_orbit_periods.py``).
+    period and transient. For three sliders at generic parameters the
+    orbit repeats after at most one cycle, with a period of one cycle (300
+    random parameter sets, ``benchmarks/creep_orbit_periods.py``); at an
+    exact tie of two events the period can be longer (22 cycles at
+    A = 0.75 Ntilde, f = 0.171875, mu_s = 0.59375, mu_d = 0.34375, all exact
+    in binary).
     From four sliders on the orbits are richer: of 300 random sets of four
     sliders, 54 did not repeat within 200 cycles, and the others had
     periods of up to 39 cycles after transients of up to 170.
