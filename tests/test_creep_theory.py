@@ -12,7 +12,7 @@ import itertools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import slidernet
@@ -164,13 +164,15 @@ def test_two_slider_chain_is_the_pair_closed_form():
     np.testing.assert_allclose(dx, dx_pair, rtol=1e-12)
 
 
-@given(x=st.floats(0.0, 1.5), f=st.floats(0.01, 0.49))
+@given(x=st.floats(0.0, 1.5))
 @settings(max_examples=100, deadline=None)
-def test_the_pair_segments_are_the_closed_form_staircase(x, f):
+def test_the_pair_segments_are_the_closed_form_staircase(x):
     """Along the angle, two sliders' segments end exactly at pair_creep_steps and carry its m."""
-    segments = theory.chain_creep_segments(2, NTILDE, MU_S, MU_D, tan_alpha=(0.01, 0.49), amplitude=x * NTILDE)
     steps = theory.pair_creep_steps(x * NTILDE, NTILDE, MU_S, MU_D)
-    ends = np.array([s.lo for s in segments[1:] if s.slips != segments[segments.index(s) - 1].slips])
+    # A step on an end of the range would be a segment end or not by rounding.
+    assume(np.all(abs(steps[:, None] - np.array([0.01, 0.49])) > 1e-9))
+    segments = theory.chain_creep_segments(2, NTILDE, MU_S, MU_D, tan_alpha=(0.01, 0.49), amplitude=x * NTILDE)
+    ends = np.array([b.lo for a, b in itertools.pairwise(segments) if a.slips != b.slips])
     np.testing.assert_allclose(ends, steps[(steps > 0.01) & (steps < 0.49)], atol=1e-12)
     for seg in segments:
         mid = 0.5 * (seg.lo + seg.hi)
