@@ -140,10 +140,11 @@ def _degrees(tan_alpha: float) -> float:
 
 
 def _segments(n: int, **range_and_value: Any) -> list[dict[str, float]]:
-    """The exact orbit's segments, velocities in slips per cycle."""
+    """The exact orbit's segments: ends in tan(alpha) or in A / Ntilde, velocities in slips per cycle."""
     segs = theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, **range_and_value)
-    return [{"lo": s.lo, "hi": s.hi, "v_lo": s.dx_lo / SLIP, "v_hi": s.dx_hi / SLIP, "slips": s.slips,
-             "period": s.period} for s in segs]
+    unit = NTILDE if isinstance(range_and_value.get("amplitude"), tuple) else 1.0
+    return [{"lo": s.lo / unit, "hi": s.hi / unit, "v_lo": s.dx_lo / SLIP, "v_hi": s.dx_hi / SLIP,
+             "slips": s.slips, "period": s.period} for s in segs]
 
 
 def panel_a(p: Preset) -> dict[str, Any]:
@@ -188,8 +189,6 @@ def panel_b(p: Preset) -> dict[str, Any]:
         out["A_c"][str(n)] = theory.chain_critical_amplitude(n, NTILDE, TAN_B, MU_S, MU_D,
                                                              amplitude_max=amps[-1] * NTILDE) / NTILDE
         out["theory"][str(n)] = _segments(n, tan_alpha=TAN_B, amplitude=(amps[0] * NTILDE, amps[-1] * NTILDE))
-        for seg in out["theory"][str(n)]:
-            seg["lo"], seg["hi"] = seg["lo"] / NTILDE, seg["hi"] / NTILDE
     return out
 
 

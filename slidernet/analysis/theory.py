@@ -585,14 +585,31 @@ def mean_records(n: ArrayLike) -> np.ndarray:
 # (or L) is one slip: the motion is a map of G from one turning point to the
 # next, exact and closed-form.
 
-def _pair_creep_args(tan_alpha: float, mu_s: float, mu_d: float, owner: str) -> tuple[float, float, float]:
-    f = float(tan_alpha)
+def _check_friction(mu_s: float, mu_d: float, owner: str) -> tuple[float, float]:
     if not 0.0 < float(mu_d) < float(mu_s):
         raise param_error("mu_s", owner, f"> mu_d = {float(mu_d)!r} > 0", mu_s)
-    if not 0.0 < f < float(mu_d):
+    return float(mu_s), float(mu_d)
+
+
+def _check_tan(tan_alpha: float, mu_d: float, owner: str) -> float:
+    f = float(tan_alpha)
+    if not (math.isfinite(f) and 0.0 < f < mu_d):
         # f = 0 makes backward and forward slips tie; f >= mu_d slides away.
-        raise param_error("tan_alpha", owner, f"in (0, mu_d = {float(mu_d)!r})", tan_alpha)
-    return float(mu_s) - f, f - float(mu_s), 2.0 * (float(mu_s) - float(mu_d))
+        raise param_error("tan_alpha", owner, f"in (0, mu_d = {mu_d!r})", f)
+    return f
+
+
+def _check_amplitude(value: ArrayLike, owner: str) -> np.ndarray:
+    A = _check_finite(value, "amplitude", owner)
+    if (A < 0).any():
+        raise param_error("amplitude", owner, ">= 0", _first_bad(A, A < 0))
+    return A
+
+
+def _pair_creep_args(tan_alpha: float, mu_s: float, mu_d: float, owner: str) -> tuple[float, float, float]:
+    ms, md = _check_friction(mu_s, mu_d, owner)
+    f = _check_tan(tan_alpha, md, owner)
+    return ms - f, f - ms, 2.0 * (ms - md)
 
 
 def pair_creep_slips(turning_points: ArrayLike, tan_alpha: float, mu_s: float, mu_d: float) -> np.ndarray:
@@ -694,9 +711,7 @@ def pair_creep(amplitude: ArrayLike, Ntilde: float, tan_alpha: ArrayLike, mu_s: 
     ([0, 2, 4, 4], [0.0, 0.4, 0.8, 0.8])
     """
     owner = "pair_creep"
-    A = _check_finite(amplitude, "amplitude", owner)
-    if (A < 0).any():
-        raise param_error("amplitude", owner, ">= 0", _first_bad(A, A < 0))
+    A = _check_amplitude(amplitude, owner)
     nt = float(_check_positive(Ntilde, "Ntilde", owner))
     f = _check_finite(tan_alpha, "tan_alpha", owner)
     for value in np.unique(f):
@@ -922,15 +937,8 @@ def _chain_orbit(n: int, f: _Affine, x: _Affine, mu_s: Fraction, mu_d: Fraction,
 def _chain_args(n_sliders: int, mu_s: float, mu_d: float, owner: str) -> tuple[int, Fraction, Fraction]:
     if isinstance(n_sliders, bool) or not isinstance(n_sliders, (int, np.integer)) or n_sliders < 2:
         raise param_error("n_sliders", owner, "an integer >= 2", n_sliders)
-    if not 0.0 < float(mu_d) < float(mu_s):
-        raise param_error("mu_s", owner, f"> mu_d = {float(mu_d)!r} > 0", mu_s)
-    return int(n_sliders), Fraction(float(mu_s)), Fraction(float(mu_d))
-
-
-def _check_tan(f: float, mu_d: Fraction, owner: str) -> Fraction:
-    if not (math.isfinite(f) and 0.0 < f < float(mu_d)):
-        raise param_error("tan_alpha", owner, f"in (0, mu_d = {float(mu_d)!r})", f)
-    return Fraction(f)
+    ms, md = _check_friction(mu_s, mu_d, owner)
+    return int(n_sliders), Fraction(ms), Fraction(md)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -1010,12 +1018,10 @@ def chain_orbit(n_sliders: int, amplitude: float, Ntilde: float, tan_alpha: floa
     """
     owner = "chain_orbit"
     n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
-    A = float(_check_finite(amplitude, "amplitude", owner))
-    if A < 0:
-        raise param_error("amplitude", owner, ">= 0", A)
+    A = float(_check_amplitude(amplitude, owner))
     nt = float(_check_positive(Ntilde, "Ntilde", owner))
-    f = _check_tan(float(_check_finite(tan_alpha, "tan_alpha", owner)), md, owner)
-    orbit = _orbit_at(n, A / nt, float(f), ms, md, max_cycles)
+    f = _check_tan(tan_alpha, float(md), owner)
+    orbit = _orbit_at(n, A / nt, f, ms, md, max_cycles)
     return dataclasses.replace(orbit, dx=orbit.dx * nt)
 
 
@@ -1077,14 +1083,12 @@ def chain_creep(n_sliders: int, amplitude: ArrayLike, Ntilde: float, tan_alpha: 
     """
     owner = "chain_creep"
     n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
-    A = _check_finite(amplitude, "amplitude", owner)
-    if (A < 0).any():
-        raise param_error("amplitude", owner, ">= 0", _first_bad(A, A < 0))
+    A = _check_amplitude(amplitude, owner)
     nt = float(_check_positive(Ntilde, "Ntilde", owner))
     f = _check_finite(tan_alpha, "tan_alpha", owner)
     A, f = np.broadcast_arrays(A, f)
     for value in np.unique(f):
-        _check_tan(float(value), md, owner)
+        _check_tan(value, float(md), owner)
     slips = np.zeros(A.shape)
     dx = np.zeros(A.shape)
     aperiodic = 0
@@ -1210,18 +1214,15 @@ def chain_creep_segments(n_sliders: int, Ntilde: float, mu_s: float, mu_d: float
         raise param_error("resolution", owner, "in (0, 1)", resolution)
     unit = Fraction(1)
     if over == "tan_alpha":
-        _check_tan(lo_f, md, owner)
-        _check_tan(hi_f, md, owner)
-        A = float(_check_finite(amplitude, "amplitude", owner))  # type: ignore[arg-type]
-        if A < 0:
-            raise param_error("amplitude", owner, ">= 0", A)
+        _check_tan(lo_f, float(md), owner)
+        _check_tan(hi_f, float(md), owner)
+        A = float(_check_amplitude(amplitude, owner))  # type: ignore[arg-type]
         x = _Affine(Fraction(A / nt))
         f = _Affine(Fraction(0), Fraction(1))
         lo, hi = Fraction(lo_f), Fraction(hi_f)
     else:
-        if lo_f < 0:
-            raise param_error("amplitude", owner, ">= 0", lo_f)
-        f = _Affine(_check_tan(float(tan_alpha), md, owner))  # type: ignore[arg-type]
+        _check_amplitude(lo_f, owner)
+        f = _Affine(Fraction(_check_tan(tan_alpha, float(md), owner)))  # type: ignore[arg-type]
         x = _Affine(Fraction(0), Fraction(1))
         unit = Fraction(nt)
         lo, hi = Fraction(lo_f / nt), Fraction(hi_f / nt)
@@ -1310,9 +1311,9 @@ def three_slider_onset(Ntilde: float, tan_alpha: float, mu_s: float, mu_d: float
     [0.46, 0.66, 0.56]
     """
     owner = "three_slider_onset"
-    _chain_args(3, mu_s, mu_d, owner)
+    ms, md = _check_friction(mu_s, mu_d, owner)
     nt = float(_check_positive(Ntilde, "Ntilde", owner))
-    ms, md, f = float(mu_s), float(mu_d), float(tan_alpha)
+    f = float(tan_alpha)
     D = 2.0 * (ms - md)
     lo, hi = max(ms - 2.0 * D, md / 2.0 - D / 4.0), 3.0 * md - 2.0 * ms
     if not lo < f < hi:

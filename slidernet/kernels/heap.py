@@ -409,11 +409,12 @@ def theta_direction(st, thetas):
 def open_driving_event(st, thetas, thc):
     """Start the avalanche of a driving event at theta_c: count it, and stamp its time (q + fraction).
 
-    The stamps of step q lie in [q, q + 1): an event at theta(t_{q+1}) itself
-    comes before the output at q + 1, and a stamp of exactly q + 1 would
-    read as one after it (an event at theta(t_{q+1}) found in step q + 1, or
-    a fraction below q's ulp, also reads q + 1). Periodic drivers with
-    constant thresholds put events exactly there.
+    The stamps of step q lie in [q, q + 1). An event at theta(t_{q+1})
+    itself (or a fraction that rounds up to 1) happens in step q, before the
+    output at q + 1, but q + fraction would read q + 1, the stamp of an event
+    at the start of step q + 1, after that output. It is stamped one ulp
+    below q + 1 instead. Periodic drivers with constant thresholds put
+    events exactly on the samples.
     """
     q = st.q
     st.av_slips = 0
