@@ -1,14 +1,126 @@
-"""Input checks shared by every stage (as scikit-learn's ``utils/validation``): what a plugin returns.
+"""Input checks shared by every stage (as scikit-learn's ``utils/validation``).
 
-This module sits below everything else, so that the plugins, the registry
-and the solver can all check values without importing one another.
+This module sits below everything else, so that the plugins, the model, the
+theory and the solver can all check values without importing one another:
+
+- :func:`check_scalar`: one real parameter (a plugin's, a material value);
+- :func:`check_array`: a real parameter that may be an array (the theory's
+  vectorised functions);
+- :func:`checked_output`: what a plugin returns.
+
+One rule for every parameter: a real number is an ``int`` or a ``float``
+(any :class:`numbers.Real`, numpy's scalars included), never a ``bool`` and
+never a string, even one that reads as a number (``"0.1"`` in a TOML file is
+a typo to report, not a value to guess).
 """
 
 from __future__ import annotations
 
-import numpy as np
+import math
+import numbers
+from collections.abc import Callable
+from typing import Any
 
-from slidernet.errors import PluginError
+import numpy as np
+from numpy.typing import ArrayLike
+
+from slidernet.errors import PluginError, param_error
+
+# What a requirement asks of a finite float, or elementwise of a finite float array.
+_TESTS: dict[str, Callable[[Any], Any]] = {
+    "finite": np.isfinite,
+    "> 0": lambda x: x > 0,
+    ">= 0": lambda x: x >= 0,
+    "!= 0": lambda x: x != 0,
+    ">= 1": lambda x: x >= 1,
+}
+
+
+def _requirement(requirement: str) -> Callable[[Any], Any]:
+    try:
+        return _TESTS[requirement]
+    except KeyError:  # pragma: no cover - a caller's typo, not a user's
+        raise ValueError(f"unknown requirement {requirement!r}; one of {sorted(_TESTS)}") from None
+
+
+def check_scalar(value: object, param: str, owner: str, requirement: str = "finite") -> float:
+    """``value`` as a float, refused unless it is a finite real number meeting ``requirement``.
+
+    Parameters
+    ----------
+    value : object
+        What the user gave.
+    param, owner : str
+        The parameter's name and who owns it (a plugin's registered name,
+        ``units``, a theory function), for the message.
+    requirement : {"finite", "> 0", ">= 0", "!= 0", ">= 1"}
+        What the value must satisfy beyond being finite.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ConfigError
+        Naming the parameter, its owner, the requirement and the value.
+
+    Examples
+    --------
+    >>> check_scalar(2, "period", "sinusoidal", "> 0")
+    2.0
+    >>> check_scalar("0.1", "std", "gaussian", "> 0")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The 'std' parameter of gaussian must be a real number > 0. Got '0.1' instead.
+    >>> check_scalar(float("inf"), "mean", "gaussian")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The 'mean' parameter of gaussian must be finite. Got inf instead.
+    """
+    test = _requirement(requirement)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        kind = "a real number" if requirement == "finite" else f"a real number {requirement}"
+        raise param_error(param, owner, kind, value)
+    x = float(value)
+    if not math.isfinite(x):
+        # NaN fails "> 0" too, but "finite" is then the useful word.
+        raise param_error(param, owner, "finite" if requirement == "finite" else f"finite and {requirement}", x)
+    if not bool(test(x)):
+        raise param_error(param, owner, requirement, x)
+    return x
+
+
+def check_array(value: ArrayLike, param: str, owner: str, requirement: str = "finite") -> np.ndarray:
+    """``value`` as a float array, refused unless every element is finite and meets ``requirement``.
+
+    The same rule as :func:`check_scalar`, element by element: strings and
+    booleans are refused. The message reports one offending element, not a
+    whole (possibly huge) array.
+
+    Examples
+    --------
+    >>> check_array([1, 2.5], "n", "mu_max_moments", ">= 0").tolist()
+    [1.0, 2.5]
+    >>> check_array([1.0, -2.0], "n", "mu_max_moments", ">= 0")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The 'n' parameter of mu_max_moments must be >= 0. Got -2.0 instead.
+    """
+    test = _requirement(requirement)
+    kind = "a real number or an array of them" + ("" if requirement == "finite" else f", {requirement}")
+    raw = np.asarray(value)
+    if raw.dtype.kind not in "iuf":
+        raise param_error(param, owner, kind, value)
+    arr = raw.astype(np.float64, copy=False)
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = float(arr[~finite].flat[0])
+        raise param_error(param, owner, "finite" if requirement == "finite" else f"finite and {requirement}", bad)
+    ok = np.broadcast_to(test(arr), arr.shape)
+    if not ok.all():
+        raise param_error(param, owner, requirement, float(arr[~ok].flat[0]))
+    return arr
 
 
 def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str, call: str) -> np.ndarray:
