@@ -180,3 +180,30 @@ def test_cli_messages_use_the_cli_spelling(tmp_path, config, capsys):
     line = _one_line_error(capsys, main(["run", str(config), "--out", str(out), "--no-progress"]))
     assert "holds an interrupted run" in line and "--resume" in line and "--overwrite" in line
     assert "resume=True" not in line
+
+
+def test_a_block_renamed_on_a_name_collision_is_still_read(tmp_path):
+    # Two blocks with the same first realization and size: the second is written under a suffixed
+    # name, after its realizations' partial files were deleted. That name used to be invisible to the
+    # block pattern, so its records were lost.
+    import numpy as np
+
+    from slidernet.io.store import RunStore
+
+    store = RunStore(tmp_path, {"config": {}, "seed": 1, "realizations": 3, "slidernet_version": "x"},
+                     resume=False)
+    store.open()
+
+    def record(r: int) -> dict:
+        return {"n": np.array([r, r + 1], np.int64), "events": {"node": np.arange(r, dtype=np.int64)}}
+
+    for batch in ([0, 1], [0, 2]):
+        for r in batch:
+            store.add(r, record(r))
+        store.flush()
+    assert sorted(p.name for p in store.dir.glob("block-*")) == ["block-000000000-2-1.npz",
+                                                                 "block-000000000-2.npz"]
+    assert sorted(store.done()) == [0, 1, 2]
+    records = list(store.records(3))
+    for r, rec in enumerate(records):
+        assert rec["n"].tolist() == [r, r + 1] and rec["events"]["node"].tolist() == list(range(r))

@@ -7,7 +7,10 @@ Layout of ``DIR/checkpoint/`` (plain numeric files and JSON; no pickle)::
                              number of realizations, the slidernet version
     block-<first>-<k>.npz    finished realizations, written together: their
                              indices, then every record stacked (ragged records,
-                             the event catalogue, concatenated with offsets)
+                             the event catalogue, concatenated with offsets);
+                             block-<first>-<k>-<j>.npz where that name is taken
+                             (j = 1, 2, ...; a realization in two blocks is read
+                             from the one written last)
     partial-<r>.npz          a realization in progress (slidernet.io.checkpoint)
 
 Every file is written to a temporary name and renamed, so a kill at any time
@@ -32,7 +35,14 @@ from slidernet.io import atomic_output
 
 Record = dict[str, Any]
 
-_BLOCK = re.compile(r"block-(\d+)-(\d+)\.npz")
+# A block's name; the suffix -<j> tells apart blocks whose first realization and size agree.
+_BLOCK = re.compile(r"block-(\d+)-(\d+)(?:-(\d+))?\.npz")
+
+
+def _block_order(path: Path) -> tuple[int, int]:
+    """(first realization, suffix j; 0 without one): the order in which blocks were written, per first index."""
+    m = _BLOCK.fullmatch(path.name)
+    return int(m.group(1)), int(m.group(3) or 0)
 
 
 def _flat_diff(a: Any, b: Any, prefix: str = "") -> list[str]:
@@ -175,8 +185,7 @@ class RunStore:
     def _blocks(self) -> list[Path]:
         if not self.dir.exists():
             return []
-        return sorted((p for p in self.dir.iterdir() if _BLOCK.fullmatch(p.name)),
-                      key=lambda p: int(_BLOCK.fullmatch(p.name).group(1)))
+        return sorted((p for p in self.dir.iterdir() if _BLOCK.fullmatch(p.name)), key=_block_order)
 
     def done(self) -> dict[int, tuple[Path, int]]:
         """Finished realization -> (its block, its row in the block)."""
