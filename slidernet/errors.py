@@ -40,6 +40,12 @@ class CheckpointError(SlidernetError, ValueError):
     """A checkpoint file is unreadable, or belongs to another run or scene."""
 
 
+class SnapshotError(SlidernetError, ValueError):
+    """A snapshot of a realization does not fit the realization it is restored into: another scene,
+    another seed, or missing or malformed state. The message is a predicate ("was written for another
+    scene: ..."), so that a caller can prefix what it read the snapshot from."""
+
+
 class ResultError(SlidernetError, ValueError):
     """A result file or dataset cannot be read, or lacks what is asked of it (not a run of slidernet,
     a sweep where one run is wanted, no per-node variables for a network picture)."""

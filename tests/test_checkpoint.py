@@ -281,7 +281,7 @@ def test_a_failed_save_leaves_the_previous_checkpoint_and_no_temporary_file(
 def test_state_this_module_does_not_know_is_refused(tmp_path: Path) -> None:
     real = Realization(fresh_scene("pair_tilt"), np.random.SeedSequence(11))
     real.new_state = np.zeros(3)
-    with pytest.raises(CheckpointError, match=r"\['new_state'\] that slidernet.io.checkpoint neither saves"):
+    with pytest.raises(RuntimeError, match=r"\['new_state'\] that Realization.snapshot neither saves"):
         save_realization(real, tmp_path / "r.npz", META)
     assert not (tmp_path / "r.npz").exists()
 

@@ -213,3 +213,61 @@ def test_one_overloaded_slider_is_an_avalanche_of_one_slip(kernel):
     assert r.n == 1 and res["n_events"] == 0
     assert r.events()["node"].tolist() == [node]
     assert res["avalanche_count"].tolist() == [1] + [0] * (res["avalanche_count"].size - 1)
+
+
+def test_a_small_max_events_caps_the_catalogue_at_the_real_chunk_size():
+    # At the real buffer size (EVENT_CHUNK = 65536 rows, not the 64 the other tests patch in), a cap
+    # below the buffer was never applied, and past it the kernel asked for a flush at every slip for
+    # ever: this run (a chain of 8, 3000 tau_th, 1.4 s uncapped) hung.
+    cfg = make_config(**{"seed": 1, "realizations": 2, "steps": 3000, "observables": ["n", "events"],
+                         "network": {"kind": "chain", "n": 8, "Ntilde": 1e-7}, "driver.sigma_theta": 1e-6,
+                         "solver.max_events": 100})
+    with pytest.warns(RuntimeWarning, match=r"solver.max_events = 100 events") as caught:
+        r = Realization(Scene.from_config(load_config(cfg)), np.random.SeedSequence(5)).advance()
+    assert sum("max_events" in str(w.message) for w in caught) == 1  # warned once
+    res = r.result()
+    assert res["n"][-1] > 1000  # the physics went on past the cap
+    assert res["events"]["node"].size == 100 and res["events_complete"] is False
+    np.testing.assert_array_equal(res["events"]["time"], r.events()["time"])
+    with pytest.warns(RuntimeWarning, match=r"solver.max_events = 100 events"):
+        ds = slidernet.run(cfg)
+    assert (ds["events_complete"].values == 0).all()
+
+
+@pytest.mark.parametrize("cap", [1, 64, 65_537], ids=["one", "below-chunk", "past-chunk"])
+def test_the_cap_is_exact_whatever_its_relation_to_the_buffer(cap):
+    cfg = load_config(events_config({"kind": "chain", "n": 6}, steps=2000, events=True,
+                                    **{"solver.max_events": cap, "driver.sigma_theta": 3e-6}))
+    with pytest.warns(RuntimeWarning, match=rf"solver.max_events = {cap} events"):
+        r = Realization(Scene.from_config(cfg), np.random.SeedSequence(2)).advance()
+    res = r.result()
+    assert res["n"][-1] > cap
+    assert res["events"]["node"].size == cap and res["events_complete"] is False
+
+
+@pytest.mark.parametrize("net", [NETWORKS["chain"], NETWORKS["triangular"]], ids=["chain", "triangular"])
+def test_a_node_that_a_recomputation_finds_unstable_opens_its_own_avalanche(net):
+    # Resetting the forces from u can find a node a rounding error over its threshold (exact ties occur
+    # with constant thresholds and periodic drivers). Here u is nudged so that the reset puts the most
+    # loaded node 1e-12 over its threshold. Its slips used to run under the previous avalanche's id and
+    # time, outside the avalanche counts.
+    cfg = load_config(events_config(net, steps=40))
+    r = Realization(Scene.from_config(cfg), np.random.SeedSequence(5)).advance(20)
+    before = r.result()
+    N = r.mu.size
+    F = r.forces().reshape(N, -1)
+    j = int(np.argmax(np.linalg.norm(F, axis=1) / r.mu))
+    d = F.shape[1]
+    K_jj = r.scene.K.toarray()[d * j: d * j + d, d * j: d * j + d]
+    c = 1.0 - r.mu[j] * (1.0 + 1e-12) / np.linalg.norm(F[j])
+    u = r.backend.nodes.u.reshape(N, d)
+    u[j] += np.linalg.solve(K_jj, c * F[j])  # then F_j = (1 - c) F_j: |F_j| = mu_j (1 + 1e-12)
+    r.recompute_forces()
+    assert np.linalg.norm(r.forces().reshape(N, -1)[j]) > r.mu[j]
+    r.advance()
+    res, ev = r.result(), r.events()
+    k = before["events"]["node"].size
+    assert ev["node"][k] == j  # the next slip is that node's ...
+    assert ev["avalanche"][k] == before["n_events"] + 1  # ... in an avalanche of its own ...
+    assert ev["time"][k] == 20.0  # ... at the current theta: the start of step 20
+    assert np.unique(ev["avalanche"]).size == res["n_events"] == res["avalanche_count"].sum()

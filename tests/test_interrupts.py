@@ -228,3 +228,51 @@ def test_ctrl_c_stops_a_run_on_a_dask_cluster(tmp_path, config, reference, monke
     monkeypatch.delenv("SLIDERNET_TEST_GATE")
     slidernet.run(cfg, out=out, resume=True, workers=1).close()
     _assert_same_bits(out / "result.nc", reference)
+
+
+# One thermal step of about 1e6 slips per realization (sigma_theta/Ntilde = 2e5 on a chain of 4): a run
+# whose every step takes long, as a stuck loop would.
+LONG_STEP = """\
+seed = 5
+realizations = 2
+steps = 2
+observables = ["n", "mu_max", "x_G"]
+[network]
+kind = "chain"
+n = 4
+Ntilde = 1e-7
+[friction]
+mu_d = 0.5
+[friction.static]
+name = "gated"
+[driver]
+name = "gaussian_steps"
+sigma_theta = 2e-2
+[execution]
+checkpoint_every = 1e-9
+"""
+
+
+@pytest.mark.slow
+def test_sigterm_stops_a_realization_inside_a_long_thermal_step(tmp_path):
+    # The stop is asked wherever the kernel returns to refill a buffer, not only between thermal
+    # steps: the realization stops within the step it stands in at the gate, and resumes to the bits.
+    # (Before, it ran to the end of the step: a step, or a loop, that never ended could not be stopped.)
+    config = tmp_path / "long_step.toml"
+    config.write_text(LONG_STEP)
+    rc, err = _finish(_cli("run", str(config), "--out", str(tmp_path / "reference"), "--workers", "1"))
+    assert rc == 0, err
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", "1", gate=gate)
+    _wait_at_gate(gate, proc, 1)
+    os.kill(proc.pid, signal.SIGTERM)
+    assert "SIGTERM received" in proc.stderr.readline()  # the stop is requested before the gate opens
+    (gate / "open").touch()
+    rc, err = _finish(proc)
+    assert rc == 143, err
+    for r in range(1):
+        with np.load(out / "checkpoint" / f"partial-{r:09d}.npz", allow_pickle=False) as z:
+            header = json.loads(bytes(z["header"]).decode())
+        assert header["step"] == 0 and header["n"] > GATE_AFTER // 2  # stopped inside step 0
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", tmp_path / "reference" / "result.nc")

@@ -107,3 +107,41 @@ def test_the_kernel_name_scan_finds_a_branch(tmp_path):
     planted = tmp_path / "planted.py"
     planted.write_text('if scene.kernel == "vec":\n    pass\nok = kernel in ("csr", "other")\n')
     assert _kernel_name_comparisons(planted) == [1, 3]
+
+
+def _graph() -> dict[str, set[str]]:
+    """Module -> the slidernet modules it imports (every import: deferred, and for type hints only)."""
+    names = {_module_name(p).removesuffix(".__init__"): p for p in MODULES}
+    graph = {}
+    for name, path in names.items():
+        targets = set()
+        for m in _imports(path):
+            # "from slidernet.a import b" may name a module a.b or a name in a; either way a is imported.
+            while m not in names and "." in m:
+                m = m.rsplit(".", 1)[0]
+            if m in names and m != name:
+                targets.add(m)
+        graph[name] = targets
+    return graph
+
+
+def test_no_import_cycle_between_modules():
+    # Within a stage too, and even through an import for type hints only (ARCHITECTURE.md): a cycle
+    # makes a module's meaning depend on which of the two is imported first.
+    graph = _graph()
+    cycles = []
+    state: dict[str, int] = {}
+
+    def visit(node: str, path: list[str]) -> None:
+        state[node] = 1
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == 1:
+                cycles.append([*path[path.index(nxt):], nxt])
+            elif nxt not in state:
+                visit(nxt, [*path, nxt])
+        state[node] = 2
+
+    for start in sorted(graph):
+        if start not in state:
+            visit(start, [start])
+    assert not cycles, cycles

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import multiprocessing
 import os
 import signal
@@ -77,23 +78,30 @@ def scene_of(config_json: str):
     return Scene.from_config(load_config(json.loads(config_json)))
 
 
-# The stop flag of this process: set by the runner's signal handler in this
-# process, or replaced by a pool worker's initializer with the flag the parent
-# sets (a multiprocessing.Event). Read by the tasks between chunks of steps.
-_PROCESS_STOP: Any = threading.Event()
+# A pool worker's stop flag: the multiprocessing.Event its parent sets, handed over by the pool's
+# initializer (an Event crosses to another process only by inheritance, never as a task's argument).
+# It lives and dies with the worker process, which serves one pool of one run; in the parent, and in
+# any process that is not such a worker, it stays None.
+_WORKER_STOP: Any = None
 
 
 class StopSignal:
     """Ctrl-C (SIGINT) and SIGTERM during a run, as a context manager.
 
     The first signal only asks: every running realization stops at its next
-    clean point between two chunks of thermal steps (at most about half a
-    second of work, or one step if a step takes longer), saves its state,
-    and no queued realization starts. A second signal stops at once, raising
+    clean point, between two chunks of thermal steps (at most about half a
+    second of work) or, within a step, at the next refill of a draw buffer
+    (every ``solver.batch`` slips at most), saves its state, and no queued
+    realization starts. A second signal stops at once, raising
     KeyboardInterrupt where the main thread is: every file is written
     atomically, so the folder still holds the last saved state of each
     realization. Outside the main thread (where Python cannot catch
     signals) this does nothing.
+
+    The request belongs to this object: the realizations of its run read it
+    (:meth:`is_set`, passed down to :func:`run_realization`), and nothing of
+    it outlives the run, so a later run, or a direct call of
+    :func:`run_realization`, is never stopped by an earlier one.
 
     Attributes
     ----------
@@ -112,11 +120,14 @@ class StopSignal:
         """True once a signal asked the run to stop."""
         return self.signum is not None
 
+    def is_set(self) -> bool:
+        """The same as :attr:`requested`, as the callable a realization polls."""
+        return self.signum is not None
+
     def request(self, signum: int = signal.SIGINT) -> None:
         """Ask the run to stop, as the first signal does (hooks and tests call it directly)."""
         if self.signum is None:
             self.signum = int(signum)
-            _PROCESS_STOP.set()
 
     def _handle(self, signum: int, frame: Any) -> None:
         if self.signum is not None:
@@ -127,8 +138,6 @@ class StopSignal:
               "clean point and are saved; send it again to stop at once.", file=sys.stderr, flush=True)
 
     def __enter__(self) -> StopSignal:
-        global _PROCESS_STOP
-        _PROCESS_STOP = threading.Event()  # a fresh flag: an earlier run's stop is not this run's
         if threading.current_thread() is threading.main_thread():
             for sig in self.SIGNALS:
                 self._previous[sig] = signal.signal(sig, self._handle)
@@ -140,15 +149,31 @@ class StopSignal:
         self._previous.clear()
 
 
-def _stop_checker(stop: str | None) -> Callable[[], bool]:
-    """How a task learns that the run is stopping: its process's flag, or a Dask Event by name."""
+Stop = Callable[[], bool] | str | None  # how a task learns that its run is stopping: see run_realization
+
+# Seconds between two questions to a Dask Event inside a realization: each is a round trip to the scheduler.
+_DASK_POLL = 0.2
+
+
+def _stop_checker(stop: Stop) -> Callable[[], bool]:
+    """``stop`` as a callable: itself, a Dask Event by name (asked at most every _DASK_POLL s), or never."""
     if stop is None:
-        flag = _PROCESS_STOP
-        return flag.is_set
+        return lambda: False
+    if callable(stop):
+        return stop
     from distributed import Event
 
     event = Event(stop)
-    return event.is_set
+    last, answer = -math.inf, False
+
+    def asked() -> bool:
+        nonlocal last, answer
+        now = time.monotonic()
+        if not answer and now - last >= _DASK_POLL:
+            last, answer = now, event.is_set()
+        return answer
+
+    return asked
 
 
 def _advance_with_checkpoints(real, partial: Path | None, every: float, meta: dict[str, Any],
@@ -174,7 +199,9 @@ def _advance_with_checkpoints(real, partial: Path | None, every: float, meta: di
                 save_realization(real, partial, meta)
             return False
         t0 = time.monotonic()
-        real.advance(min(real.step + chunk, steps))
+        # The stop is also asked inside the chunk, wherever the kernel returns to refill a buffer: a
+        # step that runs long (or an endless loop) is stopped within solver.batch slips.
+        real.advance(min(real.step + chunk, steps), stop=stopped)
         took = time.monotonic() - t0
         chunk = max(1, min(2 * chunk, int(chunk * target / took) if took > 0 else 2 * chunk))
         if partial is not None and real.step < steps and time.monotonic() - last >= every:
@@ -185,7 +212,7 @@ def _advance_with_checkpoints(real, partial: Path | None, every: float, meta: di
 
 def run_realization(config_json: str, seed: int, r: int, partial: str | None = None,
                     every: float = 60.0, meta: dict[str, Any] | None = None,
-                    stop: str | None = None) -> Record | None:
+                    stop: Stop = None) -> Record | None:
     """Run realization ``r`` of a configuration and return its records (the task of every backend).
 
     Parameters
@@ -203,9 +230,11 @@ def run_realization(config_json: str, seed: int, r: int, partial: str | None = N
         Seconds between two saves.
     meta : dict, optional
         What identifies the run, stored in and checked against ``partial``.
-    stop : str, optional
-        The name of a Dask Event that asks the run to stop; None: this
-        process's own stop flag (see :class:`StopSignal`).
+    stop : callable, str or None
+        What asks the run to stop: a callable polled between chunks of steps
+        and at every buffer refill inside them (:meth:`StopSignal.is_set`,
+        a pool worker's flag), the name of a Dask Event, or None (nothing
+        stops it).
 
     Returns
     -------
@@ -238,10 +267,14 @@ Task = Callable[[int], tuple]  # r -> the arguments of run_realization
 
 
 def _task(*args: Any) -> tuple[Record, list[tuple[type[Warning], str]]]:
-    """:func:`run_realization` in a worker, with the warnings it raised, for the caller to re-raise."""
+    """:func:`run_realization` in a worker, with the warnings it raised, for the caller to re-raise.
+
+    Without a Dask Event's name among ``args``, the stop is the pool worker's flag.
+    """
+    stop = args[6] if len(args) > 6 else (None if _WORKER_STOP is None else _WORKER_STOP.is_set)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        record = run_realization(*args)
+        record = run_realization(*args[:6], stop=stop)
     return record, [(w.category, str(w.message)) for w in caught]
 
 
@@ -256,7 +289,7 @@ def _in_process(indices: Sequence[int], args: Task, stop: StopSignal) -> Iterato
     for r in indices:
         if stop.requested:
             return
-        record = run_realization(*args(r))
+        record = run_realization(*args(r), stop=stop.is_set)
         if record is not None:
             yield r, record
 
@@ -272,8 +305,8 @@ _POLL = 0.1
 
 def _init_worker(flag: Any) -> None:
     """Initializer of a pool worker: the parent's flag is its stop flag; signals are the parent's."""
-    global _PROCESS_STOP
-    _PROCESS_STOP = flag
+    global _WORKER_STOP
+    _WORKER_STOP = flag
     # Ctrl-C reaches every process of the terminal's group, and a batch
     # scheduler may send SIGTERM to every process of a job. The parent alone
     # decides, through the flag, so that each running realization stops at a

@@ -40,6 +40,8 @@ from slidernet.kernels.state import (
     STATE,
     TILT_LIMIT,
     TILT_MAX_ITER,
+    TILT_NEED_DRAWS,
+    TILT_TOO_LONG,
     Catalogue,
     Chain,
     Draws,
@@ -50,7 +52,7 @@ from slidernet.kernels.state import (
     Settings,
     new_state,
 )
-from slidernet.kernels.tilt import tilt_test_pair
+from slidernet.kernels.tilt import tilt_status, tilt_test_pair
 
 __all__ = [
     "AVALANCHE_LIMIT",
@@ -64,6 +66,8 @@ __all__ = [
     "STATE",
     "TILT_LIMIT",
     "TILT_MAX_ITER",
+    "TILT_NEED_DRAWS",
+    "TILT_TOO_LONG",
     "Catalogue",
     "Chain",
     "Draws",
@@ -79,5 +83,6 @@ __all__ = [
     "run_pair",
     "run_plane",
     "stiffness_times",
+    "tilt_status",
     "tilt_test_pair",
 ]

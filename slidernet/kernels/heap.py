@@ -263,6 +263,35 @@ def open_initial_relaxation(st, heaps):
 
 
 @kernel_jit(inline="always")
+def open_recomputed_avalanche(st, heaps, thetas):
+    """Open an avalanche for nodes that a recomputation of the forces found over their threshold.
+
+    Between avalanches every node is stable; resetting the forces from the
+    displacements (``RECOMPUTE``) can still find a node a rounding error
+    over its threshold, which is common where thresholds are equal and the
+    driver periodic (exact ties by design). Its slips are a new avalanche,
+    like a driving event at the current theta: counted in ``n_events`` and
+    in the avalanche sizes, stamped with the time of the current theta.
+    Without this they ran under the previous avalanche's id and time, and
+    the creep observables merged them into it. It has no driving slip, so
+    its count starts at -1, as the relaxation at t = 0
+    (:func:`open_initial_relaxation`). Call it on every entry of a network
+    kernel, after that function; it does nothing inside an avalanche, before
+    t = 0 is closed, or with no unstable node.
+    """
+    if st.started == 0 or st.in_avalanche != 0 or heaps.size[UNSTABLE] == 0:
+        return
+    q = st.q
+    st.av_slips = -1
+    st.in_avalanche = 1
+    st.n_events += 1
+    time = float(q)
+    if q + 1 < thetas.size and thetas[q + 1] != thetas[q]:
+        time = q + (st.theta - thetas[q]) / (thetas[q + 1] - thetas[q])
+    st.event_time = min(max(time, float(q)), math.nextafter(q + 1.0, q))
+
+
+@kernel_jit(inline="always")
 def close_t0(st, out_steps):
     """Close t = 0 once the network is stable; True if the t = 0 output is due now.
 

@@ -37,6 +37,7 @@ from slidernet.kernels.heap import (
     next_driving_event,
     open_driving_event,
     open_initial_relaxation,
+    open_recomputed_avalanche,
     redraw_threshold,
     theta_direction,
     tree_set,
@@ -181,6 +182,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
     st = state[0]
     steps = thetas.size - 1
     open_initial_relaxation(st, heaps)
+    open_recomputed_avalanche(st, heaps, thetas)
     while True:
         while heaps.size[UNSTABLE] > 0:
             i = heaps.node[UNSTABLE, 0]

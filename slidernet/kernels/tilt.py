@@ -2,7 +2,15 @@
 
 from __future__ import annotations
 
-from slidernet.kernels.state import DONE, NEED_TILT, TILT_LIMIT, TILT_MAX_ITER, kernel_jit
+from slidernet.kernels.state import (
+    DONE,
+    NEED_TILT,
+    TILT_LIMIT,
+    TILT_MAX_ITER,
+    TILT_NEED_DRAWS,
+    TILT_TOO_LONG,
+    kernel_jit,
+)
 
 
 @kernel_jit(inline="always")
@@ -29,8 +37,9 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
     The appendix's rules then act on the forces per unit normal load, the
     spring's being F / c; F is carried in units of the normal load on the
     flat. With :func:`flat_onset` (c = 1) this is the appendix as written.
-    Returns f at which the pair slides, -1.0 if the draw buffers ran out
-    (read positions left untouched), -2.0 after ``TILT_MAX_ITER`` iterations.
+    Returns f at which the pair slides, ``TILT_NEED_DRAWS`` if the draw
+    buffers ran out (read positions left untouched), ``TILT_TOO_LONG`` after
+    ``TILT_MAX_ITER`` iterations.
     """
     tilt_mu = draws.tilt_mu
     tilt_u = draws.tilt_u
@@ -48,7 +57,7 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
             # Creep: the damped motion stops; the appendix redraws both
             # thresholds and a force uniform in [f - mu1, mu2 - f].
             if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
-                return -1.0
+                return TILT_NEED_DRAWS
             mu1 = tilt_mu[p_mu]
             mu2 = tilt_mu[p_mu + 1]
             p_mu += 2
@@ -57,7 +66,7 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
             p_u += 1
         else:
             if p_mu + 1 > tilt_mu.size:
-                return -1.0
+                return TILT_NEED_DRAWS
             if i == 1:
                 FN += 2.0 * (mu1 - mu_d)
                 mu1 = tilt_mu[p_mu]
@@ -66,7 +75,7 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
                 mu2 = tilt_mu[p_mu]
             p_mu += 1
         F = FN * c  # exact for c = 1
-    return -2.0
+    return TILT_TOO_LONG
 
 
 @kernel_jit()
@@ -77,28 +86,41 @@ def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
     redrawn thresholds and uniforms are read from ``draws.tilt_mu`` and
     ``draws.tilt_u`` at the state's ``tilt_mu_pos`` and ``tilt_u_pos``.
     Returns the tangential force f at which the whole system slides (mu_eff
-    sample), -1.0 if the draw buffers ran out (read positions are then left
-    untouched), or -2.0 after ``TILT_MAX_ITER`` iterations.
+    sample), ``TILT_NEED_DRAWS`` if the draw buffers ran out (read positions
+    are then left untouched), or ``TILT_TOO_LONG`` after ``TILT_MAX_ITER`` iterations.
     """
     return tilt_iterations(st, draws, F, mu1, mu2, mu_d, flat_onset)
 
 
+@kernel_jit()
+def tilt_status(f):
+    """The status code of a tilt test's result ``f`` (the pair's or the network's), the one rule for both.
+
+    ``DONE`` for a sample, ``NEED_TILT`` for ``TILT_NEED_DRAWS`` (the buffers
+    ran out: refill and test again), ``TILT_LIMIT`` for ``TILT_TOO_LONG``.
+
+    >>> tilt_status(0.57) == DONE, tilt_status(TILT_NEED_DRAWS) == NEED_TILT
+    (True, True)
+    >>> tilt_status(TILT_TOO_LONG) == TILT_LIMIT
+    True
+    """
+    if f == TILT_NEED_DRAWS:
+        return NEED_TILT
+    if f == TILT_TOO_LONG:
+        return TILT_LIMIT
+    return DONE
+
+
 @kernel_jit(inline="always")
 def record_tilt(f, out, k):
-    """Add a tilt test's result f to output bin ``k`` (``out.f_sum``, ``f_sq``, ``f_count``); returns a status.
-
-    ``f`` is what :func:`tilt_iterations` returns: a sample, or -1.0 / -2.0
-    (the buffers ran out / the iteration cap), which become ``NEED_TILT`` /
-    ``TILT_LIMIT`` with nothing recorded.
-    """
-    if f == -1.0:
-        return NEED_TILT
-    if f == -2.0:
-        return TILT_LIMIT
-    out.f_sum[k] += f
-    out.f_sq[k] += f * f
-    out.f_count[k] += 1
-    return DONE
+    """Add a tilt test's result f to output bin ``k`` (``out.f_sum``, ``f_sq``, ``f_count``); returns
+    its :func:`tilt_status` (nothing is recorded unless it is ``DONE``)."""
+    status = tilt_status(f)
+    if status == DONE:
+        out.f_sum[k] += f
+        out.f_sq[k] += f * f
+        out.f_count[k] += 1
+    return status
 
 
 @kernel_jit()

@@ -55,11 +55,7 @@ import math
 
 from slidernet.kernels.heap import heap_clear, heap_set
 from slidernet.kernels.plane import slip_under, spread
-from slidernet.kernels.state import kernel_jit
-
-# Return codes (negative: no sample).
-TILT_NEED_DRAWS = -1.0
-TILT_TOO_LONG = -2.0
+from slidernet.kernels.state import TILT_NEED_DRAWS, TILT_TOO_LONG, kernel_jit
 
 # Slots of the small integer array ``pos`` (shape (N_POS,)) shared with the caller.
 P_MU = 0  # read position in the threshold buffer

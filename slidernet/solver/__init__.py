@@ -2,8 +2,12 @@
 
 - :mod:`~slidernet.solver.scene`: :class:`Scene`, everything derived once
   from a configuration (network, operators, the kernel picked for it);
-- :mod:`~slidernet.solver.streams`: the random streams of a realization and
-  the order in which its draws are read;
+- :mod:`~slidernet.solver.streams`: :class:`Streams`, the one owner of a
+  realization's random side (its streams, the order in which its draws are
+  read, the buffers and their refill);
+- :mod:`~slidernet.solver.snapshot`: :class:`Snapshot`, a realization's
+  whole state as plain data, and the checks its restore shares;
+- :mod:`~slidernet.solver.backends`: one backend per kernel;
 - :mod:`~slidernet.solver.realization`: :class:`Realization`, one
   realization's state, advanced by the compiled kernels.
 - :mod:`~slidernet.solver.creep`: the creep observables of one realization
@@ -20,7 +24,9 @@ from slidernet.solver.scene import (
     record_times,
     tilt_avalanche_cap,
 )
-from slidernet.solver.streams import draw_thetas, horizontal_draws, realization_streams
+from slidernet.solver.snapshot import Snapshot
+from slidernet.solver.streams import Streams, draw_thetas, horizontal_draws, realization_streams
 
-__all__ = ["EVENT_CHUNK", "Realization", "Scene", "build_network", "draw_thetas", "horizontal_draws",
-           "pair_tilt_applies", "realization_streams", "record_times", "simulate", "tilt_avalanche_cap"]
+__all__ = ["EVENT_CHUNK", "Realization", "Scene", "Snapshot", "Streams", "build_network", "draw_thetas",
+           "horizontal_draws", "pair_tilt_applies", "realization_streams", "record_times", "simulate",
+           "tilt_avalanche_cap"]

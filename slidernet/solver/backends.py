@@ -13,7 +13,11 @@ HOOMD-blue separates a simulation's State from its Operations:
 - ``recompute(real)``: reset incremental forces from the displacements;
 - ``flush_events(real)``, ``events(real)``: the event catalogue;
 - ``records(T)``, ``result(real)``: the kernel's own records and results;
-- ``to_arrays()``, ``from_arrays(arrays, take)``: its state for a checkpoint.
+- ``snapshot(real)``, ``restore(real, arrays)``: its state as named arrays
+  (part of :meth:`Realization.snapshot <slidernet.solver.Realization.snapshot>`).
+
+The realization is passed in as whatever has the attributes of
+:class:`Host`: the backends never import the realization's module.
 
 Backends:
 
@@ -29,17 +33,30 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
 from slidernet import kernels
+from slidernet.errors import SnapshotError
 from slidernet.solver.scene import EVENT_CHUNK, Scene
+from slidernet.solver.snapshot import take
 
-if TYPE_CHECKING:
-    from slidernet.solver.realization import Realization
 
-Take = Callable[..., np.ndarray]  # checkpoint._take: an array of the file, checked
+class Host(Protocol):
+    """What a backend reads and writes of the realization that holds it (a
+    :class:`~slidernet.solver.Realization`)."""
+
+    state: np.ndarray  # (1,) of dtype kernels.STATE
+    mu: np.ndarray  # (N,) thresholds mu_s
+    thetas: np.ndarray  # (steps + 1,) theta(t_q) / Ntilde
+    series: kernels.Series
+
+    @property
+    def buffers(self) -> kernels.Draws: ...
+
+    @property
+    def step(self) -> int: ...
 
 
 class PairBackend:
@@ -52,43 +69,43 @@ class PairBackend:
 
     kernel: ClassVar[str] = "pair"
 
-    def __init__(self, scene: Scene, real: Realization) -> None:
+    def __init__(self, scene: Scene, real: Host) -> None:
         self.scene = scene
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         """Records this kernel writes beyond every scene's (none)."""
         return {}
 
-    def run(self, real: Realization, thetas: np.ndarray) -> int:
+    def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
         return kernels.run_pair(thetas, scene.out_steps, real.mu, real.state, real.buffers, real.series,
                                 scene.settings())
 
-    def forces(self, real: Realization) -> np.ndarray:
+    def forces(self, real: Host) -> np.ndarray:
         st = real.state[0]
         F = st["theta"] - st["u"]
         return np.array([-F, F])
 
-    def displacements(self, real: Realization) -> np.ndarray:
+    def displacements(self, real: Host) -> np.ndarray:
         # Slider 1 and 2 about the centre of mass; u = theta(0) at rest.
         st = real.state[0]
         half = 0.5 * (st["u"] - real.thetas[0])
         xg = st["x_G"]
         return np.array([[xg - half], [xg + half]])
 
-    def recompute(self, real: Realization) -> float:
+    def recompute(self, real: Host) -> float:
         return 0.0
 
-    def flush_events(self, real: Realization) -> None:  # pragma: no cover - the scene never asks it
+    def flush_events(self, real: Host) -> None:  # pragma: no cover - the scene never asks it
         raise RuntimeError("the pair kernel keeps no event catalogue")
 
-    def result(self, real: Realization) -> dict[str, Any]:
+    def result(self, real: Host) -> dict[str, Any]:
         return {}
 
-    def to_arrays(self, real: Realization) -> dict[str, np.ndarray]:
+    def snapshot(self, real: Host) -> dict[str, np.ndarray]:
         return {}
 
-    def from_arrays(self, real: Realization, arrays: dict[str, np.ndarray], take: Take) -> None:
+    def restore(self, real: Host, arrays: dict[str, np.ndarray]) -> None:
         pass
 
 
@@ -102,7 +119,7 @@ class NetworkBackend:
 
     kernel: ClassVar[str]
 
-    def __init__(self, scene: Scene, real: Realization) -> None:
+    def __init__(self, scene: Scene, real: Host) -> None:
         self.scene = scene
         N = scene.network.n_nodes
         g = scene.operators.g
@@ -114,9 +131,9 @@ class NetworkBackend:
                                    moving=np.full(N if scene.slide_away else 0, -1, np.int64))
         # The unstable heap, and the driving trees over the driven nodes (g_i != 0).
         self.heaps = kernels.Heaps.empty(1, N, driven=np.any(g.reshape(N, -1) != 0.0, axis=1))
-        # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows,
-        # Python keeps the full ones (at most max_events rows in all).
-        rows = EVENT_CHUNK if scene.catalogue else 0
+        # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows (fewer where
+        # max_events is smaller), Python keeps the full ones, at most max_events rows in all.
+        rows = min(EVENT_CHUNK, scene.max_events) if scene.catalogue else 0
         self.catalogue = kernels.Catalogue(np.zeros((rows, 2), np.int64), np.zeros((rows, 3)))
         self.event_chunks: list[tuple[np.ndarray, np.ndarray]] = []
         self.events_complete = True
@@ -135,21 +152,21 @@ class NetworkBackend:
     _run: ClassVar[Callable[..., int]]
     _init_heaps: ClassVar[Callable[..., None]]
 
-    def rebuild_heaps(self, real: Realization) -> None:
+    def rebuild_heaps(self, real: Host) -> None:
         type(self)._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps)
 
-    def run(self, real: Realization, thetas: np.ndarray) -> int:
+    def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
         return type(self)._run(thetas, scene.out_steps, scene.operators, real.state, self.nodes, self.heaps,
                                real.buffers, self.catalogue, real.series, scene.settings())
 
-    def forces(self, real: Realization) -> np.ndarray:
+    def forces(self, real: Host) -> np.ndarray:
         return self.nodes.a + self.scene.operators.g * real.state["theta"][0]
 
-    def displacements(self, real: Realization) -> np.ndarray:
+    def displacements(self, real: Host) -> np.ndarray:
         return self.nodes.u.reshape(self.scene.network.n_nodes, -1)
 
-    def recompute(self, real: Realization) -> float:
+    def recompute(self, real: Host) -> float:
         g = self.scene.operators.g
         a, u = self.nodes.a, self.nodes.u
         fresh = -self._K_times(u) - g * real.thetas[0]
@@ -164,17 +181,22 @@ class NetworkBackend:
         """K u, in the shape of u."""
         return self.scene.K @ u
 
-    def flush_events(self, real: Realization) -> None:
-        """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``."""
+    def flush_events(self, real: Host) -> None:
+        """Keep the full catalogue buffer and start a new one; stop at ``solver.max_events``.
+
+        The new buffer holds at most the rows left under the cap, so the
+        kernel asks again exactly when the cap is reached: the catalogue
+        then stops, with one warning, and the run goes on.
+        """
         k = int(real.state["ev_pos"][0])
         cat = self.catalogue
         self.event_chunks.append((cat.ids[:k].copy(), cat.values[:k].copy()))
         real.state["ev_pos"] = 0
         kept = sum(c[0].shape[0] for c in self.event_chunks)
-        room = self.scene.max_events - kept
-        if room < cat.ids.shape[0]:
-            self.catalogue = kernels.Catalogue(cat.ids[:room], cat.values[:room])
-        if room == 0:
+        rows = min(EVENT_CHUNK, self.scene.max_events - kept)
+        if rows != cat.ids.shape[0]:
+            self.catalogue = kernels.Catalogue(np.zeros((rows, 2), np.int64), np.zeros((rows, 3)))
+        if rows == 0:
             real.state["ev_on"] = 0
             self.events_complete = False
             warnings.warn(
@@ -183,7 +205,7 @@ class NetworkBackend:
                 RuntimeWarning, stacklevel=5,
             )
 
-    def events(self, real: Realization) -> dict[str, np.ndarray]:
+    def events(self, real: Host) -> dict[str, np.ndarray]:
         """The catalogue so far (see :meth:`Realization.events`)."""
         k = int(real.state["ev_pos"][0])
         chunks = [*self.event_chunks, (self.catalogue.ids[:k], self.catalogue.values[:k])]
@@ -193,7 +215,7 @@ class NetworkBackend:
         return {"time": ev_f[:, 0].copy(), "node": ev_i[:, 0].copy(), "avalanche": ev_i[:, 1].copy(),
                 "dx": ev_f[:, 1] * Ntilde, "dy": ev_f[:, 2] * Ntilde}
 
-    def result(self, real: Realization) -> dict[str, Any]:
+    def result(self, real: Host) -> dict[str, Any]:
         res: dict[str, Any] = {"avalanche_count": self.nodes.avalanche_count.copy(),
                                "node_slips": self.nodes.node_slips.copy(),
                                "mu_s": real.mu.copy()}
@@ -202,7 +224,7 @@ class NetworkBackend:
             res["events_complete"] = self.events_complete
         return res
 
-    def to_arrays(self, real: Realization) -> dict[str, np.ndarray]:
+    def snapshot(self, real: Host) -> dict[str, np.ndarray]:
         """The backend's state as named numeric arrays (the catalogue buffer up to its last written row)."""
         arrays = {**self._named_arrays()}
         k = int(real.state["ev_pos"][0])
@@ -224,8 +246,8 @@ class NetworkBackend:
         named.update({f"heaps/{name}": a for name, a in self.heaps._asdict().items()})
         return named
 
-    def from_arrays(self, real: Realization, arrays: dict[str, np.ndarray], take: Take) -> None:
-        """Overwrite the state from :meth:`to_arrays`' arrays (``take`` checks each one).
+    def restore(self, real: Host, arrays: dict[str, np.ndarray]) -> None:
+        """Overwrite the state from :meth:`snapshot`'s arrays (each one checked).
 
         Call it after the realization's counters are restored: the catalogue's
         write position is ``real.state["ev_pos"]``.
@@ -236,7 +258,7 @@ class NetworkBackend:
         k = int(real.state["ev_pos"][0])
         rows = int(take(arrays, "events/buffer_rows", dtype=np.int64, ndim=0))
         if not 0 <= k <= rows:
-            raise ValueError(f"{k} catalogue rows are written in a buffer of {rows}")
+            raise SnapshotError(f"is inconsistent: {k} catalogue rows are written in a buffer of {rows}")
         self.catalogue = kernels.Catalogue(np.zeros((rows, 2), np.int64), np.zeros((rows, 3)))
         self.catalogue.ids[:k] = take(arrays, "events/buffer_ids", self.catalogue.ids[:k])
         self.catalogue.values[:k] = take(arrays, "events/buffer_values", self.catalogue.values[:k])
@@ -245,7 +267,8 @@ class NetworkBackend:
         ev_f = take(arrays, "events/chunks_values", dtype=np.float64, ndim=2)
         total = int(counts.sum())
         if (counts < 0).any() or ev_i.shape != (total, 2) or ev_f.shape != (total, 3):
-            raise ValueError(f"the catalogue chunks of {counts.tolist()} rows are {ev_i.shape} and {ev_f.shape}")
+            raise SnapshotError(f"is inconsistent: the catalogue chunks of {counts.tolist()} rows are "
+                                f"{ev_i.shape} and {ev_f.shape}")
         cuts = np.cumsum(counts)[:-1]
         self.event_chunks = [(i.copy(), f.copy()) for i, f in zip(np.split(ev_i, cuts), np.split(ev_f, cuts),
                                                                    strict=True)] if counts.size else []
@@ -284,6 +307,6 @@ BACKENDS: dict[str, type[PairBackend] | type[NetworkBackend]] = {
 }
 
 
-def backend_for(scene: Scene, real: Realization) -> PairBackend | NetworkBackend:
+def backend_for(scene: Scene, real: Host) -> PairBackend | NetworkBackend:
     """The backend of ``scene``'s kernel, with its state built for ``real``."""
     return BACKENDS[scene.kernel](scene, real)

@@ -13,18 +13,34 @@ one rearrangement to the next by solving eq. `critique` exactly.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from slidernet import kernels
-from slidernet.errors import AvalancheError, TiltTestError
+from slidernet.errors import AvalancheError, SnapshotError, TiltTestError
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver.backends import backend_for
 from slidernet.solver.creep import creep_record
 from slidernet.solver.scene import Scene, tilt_avalanche_cap
-from slidernet.solver.streams import _refill, horizontal_draws, realization_streams
+from slidernet.solver.snapshot import Snapshot, check_fingerprint, digest, scene_fingerprint, take
+from slidernet.solver.streams import Streams
 
 # Series fields a scene does not record, as the kernels take them (0-length arrays, never written).
 _NOTHING = {"mu_mean": np.empty(0), "mu_min": np.empty(0), "y_G": np.empty(0)}
+
+# The attributes of a Realization that a snapshot carries, and those the constructor rebuilds (and why that
+# is exact). A new attribute must join one of the two: snapshot() refuses a realization holding another.
+_SAVED = {"state", "mu", "out", "streams", "backend", "_tilted"}
+_REBUILT = {
+    "scene": "passed to the constructor; its fingerprint is checked",
+    "series": "the kernels' view of out: the same arrays, restored in place",
+    "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
+    "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
+}
+
+#: A stop request, polled where a kernel returns to refill a buffer: True asks the realization to stop there.
+StopCheck = Callable[[], bool]
 
 
 class Realization:
@@ -68,19 +84,9 @@ class Realization:
 
     def __init__(self, scene: Scene, seed_seq: np.random.SeedSequence) -> None:
         self.scene = scene
-        self.rngs = realization_streams(seed_seq)
-        # One stream of accepted thresholds per Generator that draws them: its
-        # surplus is state (saved by checkpoints), and where the kernels stop to
-        # refill, or how much they ask for, never changes a value.
-        self.draws = {name: TruncatedStream(scene.distribution, self.rngs[name])
-                      for name in ("thresholds", "tilt")}
-        self.thetas, self.mu, self._mu_batches = horizontal_draws(scene, self.rngs, self.draws["thresholds"])
-        # The draws waiting for the kernel; a refill replaces an array (Draws._replace).
-        if scene.tilt_at is not None:
-            tilt = (self.draws["tilt"].take(scene.batch), self.rngs["tilt_uniforms"].random(scene.batch))
-        else:
-            tilt = (np.empty(0), np.empty(0))
-        self.buffers = kernels.Draws(next(self._mu_batches), *tilt)
+        # The random side has one owner: Generators, threshold streams, buffers and their refill rule.
+        self.streams = Streams(scene, seed_seq)
+        self.thetas, self.mu = self.streams.start()
         T = scene.out_steps.size
         self.out = {
             "n": np.zeros(T, np.int64),
@@ -104,6 +110,21 @@ class Realization:
         # The kernels' view of the records: the same arrays, 0-length where the scene records nothing.
         self.series = kernels.Series(**{name: self.out[name] if name in self.out else _NOTHING[name]
                                         for name in kernels.Series._fields})
+
+    @property
+    def rngs(self) -> dict[str, np.random.Generator]:
+        """The realization's Generators by name (``driver``, ``thresholds``, ``tilt``, ``tilt_uniforms``)."""
+        return self.streams.rngs
+
+    @property
+    def draws(self) -> dict[str, TruncatedStream]:
+        """The truncated threshold streams by name (``thresholds``, ``tilt``)."""
+        return self.streams.truncated
+
+    @property
+    def buffers(self) -> kernels.Draws:
+        """The draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``)."""
+        return self.streams.buffers
 
     def recompute_forces(self) -> float:
         """Recompute a = -K u - g theta(0) + f_ext from the displacements (a sparse product with K).
@@ -153,11 +174,23 @@ class Realization:
         """Displacements u of the nodes from their reference positions, in l0, shape (N, d)."""
         return self.scene.network.Ntilde * self.backend.displacements(self)
 
-    def advance(self, to_step: int | None = None) -> Realization:
+    def advance(self, to_step: int | None = None, *, stop: StopCheck | None = None) -> Realization:
         """Run the thermal steps up to ``to_step`` (default: the last one).
 
         With ``mu_eff_at = "records"`` the network tilt test is made on the
         state at every recorded time passed on the way.
+
+        Parameters
+        ----------
+        to_step : int, optional
+            The step to reach, in [``step``, ``scene.steps``].
+        stop : callable, optional
+            Asked each time a kernel returns to refill a buffer (every
+            ``solver.batch`` slips at most, and at every event-catalogue
+            chunk): once it returns True, the realization stops there, at a
+            clean point between two slips, possibly within a thermal step,
+            and ``advance`` returns with ``step < to_step``. A
+            :meth:`snapshot` taken then resumes to the same bits.
         """
         scene = self.scene
         if self.slid_away:
@@ -167,12 +200,14 @@ class Realization:
             raise ValueError(f"to_step must lie in [{self.step}, {scene.steps}]; got {to_step}")
         if scene.tilt_at == "records":
             while self._tilted < scene.out_steps.size and scene.out_steps[self._tilted] <= to_step:
-                self._run_kernel(int(scene.out_steps[self._tilted]))
+                if not self._run_kernel(int(scene.out_steps[self._tilted]), stop):
+                    return self  # stopped before the recorded time: no tilt test of a state in between
                 if self.slid_away:
                     return self  # no tilt test of a sliding network: mu_eff_count stays 0 from here on
                 self._tilt_record(self._tilted)
                 self._tilted += 1
-        return self._run_kernel(to_step)
+        self._run_kernel(to_step, stop)
+        return self
 
     @property
     def slid_away(self) -> bool:
@@ -189,7 +224,7 @@ class Realization:
         f_ext along x. The state is left as it was; the draws come from the
         realization's tilt stream.
         """
-        from slidernet.kernels.tilt_net import N_POS, N_SLIPS, P_MU, P_U, TILT_NEED_DRAWS, tilt_test_network
+        from slidernet.kernels.tilt_net import N_POS, N_SLIPS, P_MU, P_U, tilt_test_network
 
         scene = self.scene
         o = scene.tilt_operators()
@@ -203,62 +238,30 @@ class Realization:
             G = np.zeros((N, 2))
             G[:, : F.shape[1]] = F
             pos[P_MU], pos[P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
+            buffers = self.buffers
             f = tilt_test_network(G, self.mu.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
-                                  self.buffers.tilt_mu, self.buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps,
-                                  epoch)
-            if f >= 0.0:
+                                  buffers.tilt_mu, buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps, epoch)
+            status = kernels.tilt_status(f)
+            if status == kernels.DONE:
                 st["tilt_mu_pos"], st["tilt_u_pos"] = pos[P_MU], pos[P_U]
                 return float(f)
-            if f != TILT_NEED_DRAWS:
+            if status != kernels.NEED_TILT:
                 raise TiltTestError(
                     f"The network tilt test did not reach sliding at step {self.step}: it made "
                     f"{int(pos[N_SLIPS])} slips (at most solver.max_avalanche = {scene.max_avalanche} in all, "
                     f"{tilt_avalanche_cap(N)} in one avalanche) with the load per unit normal load still "
                     f"at or below mu_d."
                 )
-            self._refill_tilt()
+            self.streams.refill_tilt(self.state)
 
     def refill(self, status: int) -> bool:
         """Top up the draw buffer a kernel's ``status`` says ran out; False for any other status.
 
-        ``NEED_MU``: the thresholds get the next batch of their stream;
-        ``NEED_TILT``: the tilt test's buffers (:meth:`_refill_tilt`). Where
-        the kernel stopped never changes which values it reads next.
+        The rule is the streams' (:meth:`Streams.refill
+        <slidernet.solver.streams.Streams.refill>`): where the kernel
+        stopped never changes which values it reads next.
         """
-        if status == kernels.NEED_MU:
-            # The batches are cut at scene.batch already: _refill's size is that batch.
-            fresh = _refill(self.buffers.mu, self.state["mu_pos"][0], lambda size: next(self._mu_batches),
-                            self.scene.batch)
-            self.buffers = self.buffers._replace(mu=fresh)
-            self.state["mu_pos"] = 0
-            return True
-        if status == kernels.NEED_TILT:
-            self._refill_tilt()
-            return True
-        return False
-
-    def _refill_tilt(self) -> None:
-        """Top up the tilt test's buffers after a test ran out of one of them.
-
-        The thresholds come from the tilt stream (``draws["tilt"]``, a
-        :class:`TruncatedStream` on ``rngs["tilt"]``), the uniforms from
-        ``rngs["tilt_uniforms"]`` (``random()`` takes one 64-bit word per value,
-        so how it is cut into calls changes nothing). Each kind is thus read
-        in an order set by the seed alone, and this policy only decides how
-        many values wait in the buffers: a buffer with fewer than ``batch``
-        unread draws gets a batch. If both still held a batch, one test needed
-        more than that (a long avalanche): both grow, so that the retry gets further.
-        """
-        scene, st, buf = self.scene, self.state[0], self.buffers
-        unread = min(buf.tilt_mu.size - st["tilt_mu_pos"], buf.tilt_u.size - st["tilt_u_pos"])
-        # Doubling when both held a batch keeps the retries logarithmic in the test's length.
-        batch = scene.batch if unread < scene.batch else 2 * max(buf.tilt_mu.size, buf.tilt_u.size)
-        self.buffers = buf._replace(
-            tilt_mu=_refill(buf.tilt_mu, st["tilt_mu_pos"], self.draws["tilt"].take, batch),
-            tilt_u=_refill(buf.tilt_u, st["tilt_u_pos"], self.rngs["tilt_uniforms"].random, batch),
-        )
-        self.state["tilt_mu_pos"] = 0
-        self.state["tilt_u_pos"] = 0
+        return self.streams.refill(status, self.state)
 
     def _tilt_record(self, k: int) -> None:
         f = self.tilt_test()
@@ -266,7 +269,8 @@ class Realization:
         self.out["f_sq"][k] += f * f
         self.out["f_count"][k] += 1
 
-    def _run_kernel(self, to_step: int) -> Realization:
+    def _run_kernel(self, to_step: int, stop: StopCheck | None) -> bool:
+        """Run the kernel to ``to_step``; False if ``stop`` asked it to stop first (see :meth:`advance`)."""
         scene = self.scene
         # The kernel stops at the end of the array it is given.
         thetas = self.thetas[: to_step + 1]
@@ -274,15 +278,15 @@ class Realization:
         while True:
             status = self.backend.run(self, thetas)
             if status == kernels.DONE:
-                return self
+                return True
             if status == kernels.SLID_AWAY:
                 # The kernel has held the records left at the state of the slide; the realization
                 # is over, at its last step for whoever advances it.
                 st["q"] = scene.steps
-                return self
+                return True
             if self.refill(status):
-                continue
-            if status == kernels.RECOMPUTE:
+                pass
+            elif status == kernels.RECOMPUTE:
                 self.recompute_forces()
             elif status == kernels.NEED_EVENTS:
                 self.backend.flush_events(self)
@@ -306,6 +310,81 @@ class Realization:
                 )
             else:  # pragma: no cover - a new status code without a handler is a bug
                 raise RuntimeError(f"unknown kernel status {status}")
+            # Every return but DONE comes within solver.batch slips (a refill) or a catalogue chunk: a
+            # loop that runs long, in one thermal step or not, sees the request here.
+            if stop is not None and stop():
+                return False
+
+    def snapshot(self) -> Snapshot:
+        """The whole state of the realization, as JSON values and named numeric arrays.
+
+        Take it between two calls of :meth:`advance` (a clean point, even
+        one where ``stop`` left it within a thermal step).
+        :meth:`restore` on a realization built from the same scene and seed
+        then gives the bits an uninterrupted run gives. The keys are listed
+        in :mod:`slidernet.solver.snapshot`. The arrays are the
+        realization's own, not copies: store them before advancing again.
+
+        Raises
+        ------
+        RuntimeError
+            If the realization holds an attribute that is neither saved nor
+            rebuilt (a new piece of state this method does not know).
+        """
+        unknown = sorted(set(vars(self)) - _SAVED - set(_REBUILT))
+        if unknown:
+            raise RuntimeError(
+                f"The realization holds {unknown} that Realization.snapshot neither saves nor rebuilds; add "
+                "each to realization._SAVED (and save it) or to realization._REBUILT."
+            )
+        streams_header, streams_arrays = self.streams.snapshot()
+        header = {"scene": scene_fingerprint(self.scene), "thetas": digest(self.thetas), **streams_header,
+                  "tilted": int(self._tilted), "step": self.step, "n": self.n}
+        arrays = {f"state/{name}": self.state[name][0] for name in kernels.STATE.names}
+        arrays["mu"] = self.mu
+        arrays.update(streams_arrays)
+        arrays.update({f"out/{name}": values for name, values in self.out.items()})
+        own = self.backend.snapshot(self)
+        arrays.update({f"backend/{name}": np.asarray(values) for name, values in own.items()})
+        return Snapshot(header, arrays)
+
+    def restore(self, snapshot: Snapshot) -> None:
+        """Overwrite the state with ``snapshot``, taken of a realization of the same scene and seed.
+
+        Call it on a realization just constructed; :meth:`advance` then goes
+        on from the snapshot's step.
+
+        Raises
+        ------
+        SnapshotError
+            If the snapshot was taken in another scene (its fingerprint), with
+            other theta(t_q) (another seed or driver), or lacks or misshapes
+            a piece of state; the message names which.
+        """
+        header, arrays = snapshot.header, snapshot.arrays
+        check_fingerprint(header.get("scene"), self.scene)
+        if header.get("thetas") != digest(self.thetas):
+            raise SnapshotError(
+                "was saved with other theta(t_q) for this seed: the driver (or its input file, or numpy) has "
+                "changed, or this is another realization's seed"
+            )
+        if "tilted" not in header:
+            raise SnapshotError("is inconsistent: its header has no 'tilted'")
+        # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
+        for name in kernels.STATE.names:
+            self.state[name] = take(arrays, f"state/{name}", dtype=kernels.STATE[name], ndim=0)
+        self.mu[...] = take(arrays, "mu", self.mu)
+        saved_out = {key.removeprefix("out/") for key in arrays if key.startswith("out/")}
+        if saved_out != set(self.out):
+            raise SnapshotError(f"is inconsistent: its records are {sorted(saved_out)}, this scene's are "
+                                f"{sorted(self.out)}")
+        for name, target in self.out.items():
+            target[...] = take(arrays, f"out/{name}", target)
+        # After the state: the backend reads the catalogue's write position from it.
+        own = {key.removeprefix("backend/"): a for key, a in arrays.items() if key.startswith("backend/")}
+        self.backend.restore(self, own)
+        self._tilted = int(header["tilted"])
+        self.streams.restore(header, arrays)
 
     def events(self) -> dict[str, np.ndarray]:
         """The event catalogue so far: one row per slip, in the order of the slips.

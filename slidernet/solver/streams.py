@@ -1,14 +1,24 @@
-"""The random streams of one realization, and the draws its horizontal evolution reads, in order."""
+"""The random side of one realization: its streams, the draws its evolution reads in order, and their owner.
+
+:class:`Streams` owns the Generators, the truncated threshold streams, the
+draw buffers the kernels read and the rule that refills them;
+:func:`realization_streams` and :func:`horizontal_draws` are the two steps
+of the documented order that the validation tools reuse on their own.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from typing import Any
 
 import numpy as np
 
 from slidernet._validation import checked_output
+from slidernet.errors import SnapshotError
+from slidernet.kernels import NEED_MU, NEED_TILT, Draws
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver.scene import Scene
+from slidernet.solver.snapshot import take
 
 
 def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random.Generator]:
@@ -107,3 +117,149 @@ def _refill(buf: np.ndarray, pos: int, draw: Callable[[int], np.ndarray], batch:
     if buf.size - pos >= batch:
         return buf[pos:]
     return np.concatenate([buf[pos:], draw(batch)])
+
+
+class Streams:
+    """The random side of one realization: its Generators, threshold streams, draw buffers and refill rule.
+
+    As numpy gives a ``BitGenerator`` its ``state``, this object owns every
+    piece of randomness a realization holds, and :meth:`snapshot` /
+    :meth:`restore` carry all of it:
+
+    - ``rngs``: the four Generators of :func:`realization_streams`;
+    - ``truncated``: the two :class:`TruncatedStream` of accepted thresholds,
+      ``"thresholds"`` (the horizontal evolution) and ``"tilt"`` (the tilt
+      tests), each with its surplus;
+    - ``buffers``: the draws waiting for the kernels
+      (:class:`slidernet.kernels.Draws`: ``mu``, ``tilt_mu``, ``tilt_u``);
+    - the refill rule (:meth:`refill`).
+
+    The read positions in the buffers (``mu_pos``, ``tilt_mu_pos``,
+    ``tilt_u_pos``) belong to the realization's state record, which the
+    kernels advance; :meth:`refill` reads them and sets them back to 0.
+
+    Constructing it draws nothing; :meth:`start` draws theta(t_q), the
+    initial thresholds and the first buffers, in the documented order.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its distribution, ``batch``, and whether it makes tilt tests).
+    seed_seq : numpy.random.SeedSequence
+        The realization's seed.
+
+    Examples
+    --------
+    >>> from slidernet.config import load_config
+    >>> scene = Scene.from_config(load_config({"network": {"Ntilde": 1e-7}, "steps": 3,
+    ...     "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}))
+    >>> streams = Streams(scene, np.random.SeedSequence(1))
+    >>> thetas, mu = streams.start()
+    >>> thetas.shape, mu.shape, streams.buffers.mu.shape == (scene.batch,)
+    ((4,), (2,), True)
+    """
+
+    def __init__(self, scene: Scene, seed_seq: np.random.SeedSequence) -> None:
+        self.scene = scene
+        self.rngs = realization_streams(seed_seq)
+        # One stream of accepted thresholds per Generator that draws them: its
+        # surplus is state, and where the kernels stop to refill, or how much
+        # they ask for, never changes a value.
+        self.truncated = {name: TruncatedStream(scene.distribution, self.rngs[name])
+                          for name in ("thresholds", "tilt")}
+        self.buffers = Draws(np.empty(0), np.empty(0), np.empty(0))
+
+    def start(self) -> tuple[np.ndarray, np.ndarray]:
+        """Draw theta(t_q) / Ntilde, shape (steps + 1,), and the initial thresholds, shape (N,); fill the buffers.
+
+        The order is the documented one: the driver's thetas, the N initial
+        thresholds, a batch of thresholds, then (with tilt tests) a batch of
+        tilt thresholds and a batch of uniforms.
+        """
+        scene = self.scene
+        thetas, mu, _ = horizontal_draws(scene, self.rngs, self.truncated["thresholds"])
+        batch = scene.batch
+        mu_batch = self.truncated["thresholds"].take(batch)
+        if scene.tilt_at is not None:
+            tilt = (self.truncated["tilt"].take(batch), self.rngs["tilt_uniforms"].random(batch))
+        else:
+            tilt = (np.empty(0), np.empty(0))
+        self.buffers = Draws(mu_batch, *tilt)
+        return thetas, mu
+
+    def refill(self, status: int, state: np.ndarray) -> bool:
+        """Top up the buffer a kernel's ``status`` says ran out; False for any other status.
+
+        ``NEED_MU``: the thresholds get the next batch of their stream;
+        ``NEED_TILT``: the tilt test's buffers (:meth:`refill_tilt`). The
+        read positions in ``state`` (the realization's record) are set back
+        to 0. Where the kernel stopped never changes which values it reads next.
+        """
+        if status == NEED_MU:
+            draw = self.truncated["thresholds"].take
+            fresh = _refill(self.buffers.mu, state["mu_pos"][0], draw, self.scene.batch)
+            self.buffers = self.buffers._replace(mu=fresh)
+            state["mu_pos"] = 0
+            return True
+        if status == NEED_TILT:
+            self.refill_tilt(state)
+            return True
+        return False
+
+    def refill_tilt(self, state: np.ndarray) -> None:
+        """Top up the tilt test's buffers after a test ran out of one of them.
+
+        The thresholds come from the tilt stream, the uniforms from
+        ``rngs["tilt_uniforms"]`` (``random()`` takes one 64-bit word per
+        value, so how it is cut into calls changes nothing). Each kind is
+        thus read in an order set by the seed alone, and this rule only
+        decides how many values wait in the buffers: a buffer with fewer than
+        ``batch`` unread draws gets a batch. If both still held a batch, one
+        test needed more than that (a long avalanche): both grow, so that the
+        retry gets further.
+        """
+        batch, st, buf = self.scene.batch, state[0], self.buffers
+        unread = min(buf.tilt_mu.size - st["tilt_mu_pos"], buf.tilt_u.size - st["tilt_u_pos"])
+        # Doubling when both held a batch keeps the retries logarithmic in the test's length.
+        size = batch if unread < batch else 2 * max(buf.tilt_mu.size, buf.tilt_u.size)
+        self.buffers = buf._replace(
+            tilt_mu=_refill(buf.tilt_mu, st["tilt_mu_pos"], self.truncated["tilt"].take, size),
+            tilt_u=_refill(buf.tilt_u, st["tilt_u_pos"], self.rngs["tilt_uniforms"].random, size),
+        )
+        state["tilt_mu_pos"] = 0
+        state["tilt_u_pos"] = 0
+
+    def snapshot(self) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+        """The streams' state: JSON values (``rngs``: each Generator's ``bit_generator.state``) and arrays
+        (``buffers/<name>``, float64 (k,); ``surplus/<name>``, float64 (k,), the threshold streams' surplus)."""
+        header = {"rngs": {name: rng.bit_generator.state for name, rng in self.rngs.items()}}
+        arrays = {f"buffers/{name}": values for name, values in self.buffers._asdict().items()}
+        arrays.update({f"surplus/{name}": stream.surplus for name, stream in self.truncated.items()})
+        return header, arrays
+
+    def restore(self, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+        """Overwrite the streams' state with a :meth:`snapshot` of the same realization.
+
+        Raises
+        ------
+        SnapshotError
+            If a Generator, a buffer or a surplus is missing or malformed.
+        """
+        rngs = header.get("rngs")
+        if not isinstance(rngs, dict) or set(rngs) != set(self.rngs):
+            raise SnapshotError(f"is inconsistent: its streams are {sorted(rngs or [])}, a realization's are "
+                                f"{sorted(self.rngs)}")
+        self.buffers = Draws(*(np.array(take(arrays, f"buffers/{name}", dtype=np.float64, ndim=1), order="C")
+                               for name in Draws._fields))
+        saved = {key.removeprefix("surplus/") for key in arrays if key.startswith("surplus/")}
+        if saved != set(self.truncated):
+            raise SnapshotError(f"is inconsistent: its threshold streams are {sorted(saved)}, a realization's are "
+                                f"{sorted(self.truncated)}")
+        for name, stream in self.truncated.items():
+            try:
+                stream.restore(take(arrays, f"surplus/{name}", dtype=np.float64, ndim=1))
+            except ValueError as exc:
+                raise SnapshotError(f"is inconsistent: {exc}") from None
+        for name, rng in self.rngs.items():
+            # In place: the threshold streams hold these very Generators.
+            rng.bit_generator.state = rngs[name]
