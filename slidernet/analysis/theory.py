@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import special
 
+from slidernet._validation import check_array, check_scalar
 from slidernet.errors import ConfigError, OrbitError, param_error
 
 __all__ = [
@@ -86,47 +87,6 @@ def _exact_harmonic_table(kmax: int) -> np.ndarray:
 
 
 _H_TABLE = _exact_harmonic_table(_H_TABLE_MAX)
-
-
-# ---------------------------------------------------------------------------
-# validation helpers
-
-
-def _as_float_array(value: ArrayLike, param: str, owner: str) -> np.ndarray:
-    try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise param_error(param, owner, "a real number or an array of them", value) from None
-
-
-def _first_bad(arr: np.ndarray, bad: np.ndarray) -> float:
-    # Report one offending element, not a whole (possibly huge) array.
-    return float(arr[bad].flat[0])
-
-
-def _check_finite(value: ArrayLike, param: str, owner: str) -> np.ndarray:
-    arr = _as_float_array(value, param, owner)
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        raise param_error(param, owner, "finite", _first_bad(arr, bad))
-    return arr
-
-
-def _check_positive(value: ArrayLike, param: str, owner: str) -> np.ndarray:
-    arr = _as_float_array(value, param, owner)
-    # NaN fails ``arr > 0`` as well, so it is reported here too.
-    bad = ~(arr > 0)
-    if bad.any():
-        raise param_error(param, owner, "> 0", _first_bad(arr, bad))
-    return _check_finite(arr, param, owner)
-
-
-def _check_count(n: ArrayLike, owner: str) -> np.ndarray:
-    arr = _as_float_array(n, "n", owner)
-    bad = ~(arr >= 0)
-    if bad.any():
-        raise param_error("n", owner, ">= 0", _first_bad(arr, bad))
-    return _check_finite(arr, "n", owner)
 
 
 def _check_dist(dist: Any, owner: str) -> None:
@@ -202,10 +162,10 @@ def mean_rearrangements(
     56.42
     """
     owner = "mean_rearrangements"
-    sigma = _check_positive(sigma_theta, "sigma_theta", owner)
-    ntilde = float(_check_positive(Ntilde, "Ntilde", owner))
-    mu_d = float(_check_finite(mu_d, "mu_d", owner))
-    mu_s_mean = float(_check_finite(mu_s_mean, "mu_s_mean", owner))
+    sigma = check_array(sigma_theta, "sigma_theta", owner, "> 0")
+    ntilde = check_scalar(Ntilde, "Ntilde", owner, "> 0")
+    mu_d = check_scalar(mu_d, "mu_d", owner)
+    mu_s_mean = check_scalar(mu_s_mean, "mu_s_mean", owner)
     if not mu_s_mean > mu_d:
         raise param_error("mu_s_mean", owner, f"> mu_d = {mu_d!r}", mu_s_mean)
     shift = mu_d * ntilde if offset else 0.0
@@ -251,8 +211,8 @@ def mu_max_cdf(dist: Any, mu: ArrayLike, n: ArrayLike) -> np.ndarray:
     """
     owner = "mu_max_cdf"
     _check_dist(dist, owner)
-    m = _check_count(n, owner) + 2.0
-    mu = _as_float_array(mu, "mu", owner)
+    m = check_array(n, "n", owner, ">= 0") + 2.0
+    mu = check_array(mu, "mu", owner)
     return np.exp(m * _log_cdf(dist, mu))
 
 
@@ -367,7 +327,7 @@ def mu_max_moments(dist: Any, n: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """
     owner = "mu_max_moments"
     _check_dist(dist, owner)
-    n_arr = _check_count(n, owner)
+    n_arr = check_array(n, "n", owner, ">= 0")
     if n_arr.size == 0:
         return np.empty(n_arr.shape), np.empty(n_arr.shape)
     m_unique, inverse = np.unique(n_arr.ravel() + 2.0, return_inverse=True)
@@ -460,9 +420,9 @@ def mu_max_leading(mu_s_mean: float, sigma_mu: float, n: ArrayLike) -> np.ndarra
     [0.6, 0.6429]
     """
     owner = "mu_max_leading"
-    mu_s_mean = float(_check_finite(mu_s_mean, "mu_s_mean", owner))
-    sigma_mu = float(_check_positive(sigma_mu, "sigma_mu", owner))
-    n_arr = _check_count(n, owner)
+    mu_s_mean = check_scalar(mu_s_mean, "mu_s_mean", owner)
+    sigma_mu = check_scalar(sigma_mu, "sigma_mu", owner, "> 0")
+    n_arr = check_array(n, "n", owner, ">= 0")
     log_n = np.log(np.maximum(n_arr, 1.0))
     return mu_s_mean + sigma_mu * np.sqrt(2.0 * log_n)
 
@@ -502,8 +462,8 @@ def msd(sigma_theta: ArrayLike, n: ArrayLike) -> np.ndarray:
     2.0
     """
     owner = "msd"
-    sigma = _check_positive(sigma_theta, "sigma_theta", owner)
-    n_arr = _check_count(n, owner)
+    sigma = check_array(sigma_theta, "sigma_theta", owner, "> 0")
+    n_arr = check_array(n, "n", owner, ">= 0")
     return sigma**2 * np.log(np.maximum(n_arr, 1.0))
 
 
@@ -531,7 +491,7 @@ def harmonic(n: ArrayLike) -> np.ndarray:
     >>> round(float(harmonic(1e9)), 6)
     21.300482
     """
-    n_arr = _check_count(n, "harmonic")
+    n_arr = check_array(n, "n", "harmonic", ">= 0")
     small = (n_arr == np.floor(n_arr)) & (n_arr <= _H_TABLE_MAX)
     index = np.where(small, n_arr, 0).astype(np.intp)
     return np.where(small, _H_TABLE[index], special.digamma(n_arr + 1.0) + np.euler_gamma)
@@ -567,7 +527,7 @@ def mean_records(n: ArrayLike) -> np.ndarray:
     >>> mean_records([0, 1, 2]).round(12).tolist()
     [0.0, 0.333333333333, 0.583333333333]
     """
-    n_arr = _check_count(n, "mean_records")
+    n_arr = check_array(n, "n", "mean_records", ">= 0")
     return harmonic(n_arr + 2.0) - 1.5
 
 
@@ -586,24 +546,21 @@ def mean_records(n: ArrayLike) -> np.ndarray:
 # next, exact and closed-form.
 
 def _check_friction(mu_s: float, mu_d: float, owner: str) -> tuple[float, float]:
-    if not 0.0 < float(mu_d) < float(mu_s):
-        raise param_error("mu_s", owner, f"> mu_d = {float(mu_d)!r} > 0", mu_s)
-    return float(mu_s), float(mu_d)
+    """(mu_s, mu_d) as floats, refused unless mu_s > mu_d > 0."""
+    md = check_scalar(mu_d, "mu_d", owner, "> 0")
+    ms = check_scalar(mu_s, "mu_s", owner)
+    if not ms > md:
+        raise param_error("mu_s", owner, f"> mu_d = {md!r}", ms)
+    return ms, md
 
 
 def _check_tan(tan_alpha: float, mu_d: float, owner: str) -> float:
-    f = float(tan_alpha)
-    if not (math.isfinite(f) and 0.0 < f < mu_d):
+    """tan(alpha) as a float, refused unless it lies in (0, mu_d)."""
+    f = check_scalar(tan_alpha, "tan_alpha", owner)
+    if not 0.0 < f < mu_d:
         # f = 0 makes backward and forward slips tie; f >= mu_d slides away.
         raise param_error("tan_alpha", owner, f"in (0, mu_d = {mu_d!r})", f)
     return f
-
-
-def _check_amplitude(value: ArrayLike, owner: str) -> np.ndarray:
-    A = _check_finite(value, "amplitude", owner)
-    if (A < 0).any():
-        raise param_error("amplitude", owner, ">= 0", _first_bad(A, A < 0))
-    return A
 
 
 def _pair_creep_args(tan_alpha: float, mu_s: float, mu_d: float, owner: str) -> tuple[float, float, float]:
@@ -649,7 +606,7 @@ def pair_creep_slips(turning_points: ArrayLike, tan_alpha: float, mu_s: float, m
     """
     owner = "pair_creep_slips"
     U, L, D = _pair_creep_args(tan_alpha, mu_s, mu_d, owner)
-    theta = _check_finite(turning_points, "turning_points", owner).ravel()
+    theta = check_array(turning_points, "turning_points", owner).ravel()
     G = 0.0
     slips = np.zeros(max(theta.size - 1, 0), dtype=np.int64)
     for k in range(theta.size - 1):
@@ -711,9 +668,9 @@ def pair_creep(amplitude: ArrayLike, Ntilde: float, tan_alpha: ArrayLike, mu_s: 
     ([0, 2, 4, 4], [0.0, 0.4, 0.8, 0.8])
     """
     owner = "pair_creep"
-    A = _check_amplitude(amplitude, owner)
-    nt = float(_check_positive(Ntilde, "Ntilde", owner))
-    f = _check_finite(tan_alpha, "tan_alpha", owner)
+    A = check_array(amplitude, "amplitude", owner, ">= 0")
+    nt = check_scalar(Ntilde, "Ntilde", owner, "> 0")
+    f = check_array(tan_alpha, "tan_alpha", owner)
     for value in np.unique(f):
         _pair_creep_args(value, mu_s, mu_d, owner)
     D = 2.0 * (float(mu_s) - float(mu_d))
@@ -1018,8 +975,8 @@ def chain_orbit(n_sliders: int, amplitude: float, Ntilde: float, tan_alpha: floa
     """
     owner = "chain_orbit"
     n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
-    A = float(_check_amplitude(amplitude, owner))
-    nt = float(_check_positive(Ntilde, "Ntilde", owner))
+    A = check_scalar(amplitude, "amplitude", owner, ">= 0")
+    nt = check_scalar(Ntilde, "Ntilde", owner, "> 0")
     f = _check_tan(tan_alpha, float(md), owner)
     orbit = _orbit_at(n, A / nt, f, ms, md, max_cycles)
     return dataclasses.replace(orbit, dx=orbit.dx * nt)
@@ -1083,9 +1040,9 @@ def chain_creep(n_sliders: int, amplitude: ArrayLike, Ntilde: float, tan_alpha: 
     """
     owner = "chain_creep"
     n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
-    A = _check_amplitude(amplitude, owner)
-    nt = float(_check_positive(Ntilde, "Ntilde", owner))
-    f = _check_finite(tan_alpha, "tan_alpha", owner)
+    A = check_array(amplitude, "amplitude", owner, ">= 0")
+    nt = check_scalar(Ntilde, "Ntilde", owner, "> 0")
+    f = check_array(tan_alpha, "tan_alpha", owner)
     A, f = np.broadcast_arrays(A, f)
     for value in np.unique(f):
         _check_tan(value, float(md), owner)
@@ -1200,7 +1157,7 @@ def chain_creep_segments(n_sliders: int, Ntilde: float, mu_s: float, mu_d: float
     """
     owner = "chain_creep_segments"
     n, ms, md = _chain_args(n_sliders, mu_s, mu_d, owner)
-    nt = float(_check_positive(Ntilde, "Ntilde", owner))
+    nt = check_scalar(Ntilde, "Ntilde", owner, "> 0")
     ranged = [name for name, value in (("tan_alpha", tan_alpha), ("amplitude", amplitude))
               if isinstance(value, (tuple, list))]
     if len(ranged) != 1:
@@ -1216,12 +1173,12 @@ def chain_creep_segments(n_sliders: int, Ntilde: float, mu_s: float, mu_d: float
     if over == "tan_alpha":
         _check_tan(lo_f, float(md), owner)
         _check_tan(hi_f, float(md), owner)
-        A = float(_check_amplitude(amplitude, owner))  # type: ignore[arg-type]
+        A = check_scalar(amplitude, "amplitude", owner, ">= 0")
         x = _Affine(Fraction(A / nt))
         f = _Affine(Fraction(0), Fraction(1))
         lo, hi = Fraction(lo_f), Fraction(hi_f)
     else:
-        _check_amplitude(lo_f, owner)
+        check_scalar(lo_f, "amplitude", owner, ">= 0")
         f = _Affine(Fraction(_check_tan(tan_alpha, float(md), owner)))  # type: ignore[arg-type]
         x = _Affine(Fraction(0), Fraction(1))
         unit = Fraction(nt)
@@ -1312,8 +1269,8 @@ def three_slider_onset(Ntilde: float, tan_alpha: float, mu_s: float, mu_d: float
     """
     owner = "three_slider_onset"
     ms, md = _check_friction(mu_s, mu_d, owner)
-    nt = float(_check_positive(Ntilde, "Ntilde", owner))
-    f = float(tan_alpha)
+    nt = check_scalar(Ntilde, "Ntilde", owner, "> 0")
+    f = check_scalar(tan_alpha, "tan_alpha", owner)
     D = 2.0 * (ms - md)
     lo, hi = max(ms - 2.0 * D, md / 2.0 - D / 4.0), 3.0 * md - 2.0 * ms
     if not lo < f < hi:
