@@ -422,7 +422,7 @@ def test_config_error_is_a_value_error():
 def test_mu_max_moments_in_chunks_gives_the_bits_of_one_batch(monkeypatch):
     # The paper's 50 500 values of n in one batch took 2.8 GB; chunks must not change a bit.
     # Seed 0: 700 values of n spread over 0 to 5e7, three chunks of 256 against one batch.
-    from slidernet.analysis import theory as th
+    from slidernet.analysis.theory import extremes as th
     law = TruncatedBelow(Gaussian(0.6, 0.01), lower=0.5, name="gaussian")
     n = np.round(np.exp(np.random.default_rng(0).uniform(0.0, np.log(5e7), 700)))
     chunked = th.mu_max_moments(law, n)
