@@ -354,11 +354,11 @@ def test_mean_records_exact():
         ),
         (
             lambda: mean_rearrangements([1e-6, float("nan")], 1e-7, MU_D, MU_S_MEAN),
-            "The 'sigma_theta' parameter of mean_rearrangements must be > 0. Got nan instead.",
+            "The 'sigma_theta' parameter of mean_rearrangements must be finite and > 0. Got nan instead.",
         ),
         (
             lambda: mean_rearrangements(float("inf"), 1e-7, MU_D, MU_S_MEAN),
-            "The 'sigma_theta' parameter of mean_rearrangements must be finite. Got inf instead.",
+            "The 'sigma_theta' parameter of mean_rearrangements must be finite and > 0. Got inf instead.",
         ),
         (
             lambda: mean_rearrangements(1e-6, 1e-7, MU_D, 0.5),
@@ -375,7 +375,7 @@ def test_mean_records_exact():
         ),
         (
             lambda: mu_max_moments(NARROW, float("inf")),
-            "The 'n' parameter of mu_max_moments must be finite. Got inf instead.",
+            "The 'n' parameter of mu_max_moments must be finite and >= 0. Got inf instead.",
         ),
         (
             lambda: mu_max_moments(object(), 3),
@@ -383,10 +383,13 @@ def test_mean_records_exact():
         ),
         (
             lambda: mu_max_leading(MU_S_MEAN, float("nan"), 10),
-            "The 'sigma_mu' parameter of mu_max_leading must be > 0. Got nan instead.",
+            "The 'sigma_mu' parameter of mu_max_leading must be finite and > 0. Got nan instead.",
         ),
         (lambda: msd(-1e-6, 10), "The 'sigma_theta' parameter of msd must be > 0. Got -1e-06 instead."),
-        (lambda: harmonic(float("nan")), "The 'n' parameter of harmonic must be >= 0. Got nan instead."),
+        (
+            lambda: harmonic(float("nan")),
+            "The 'n' parameter of harmonic must be finite and >= 0. Got nan instead.",
+        ),
         (lambda: mean_records(-3), "The 'n' parameter of mean_records must be >= 0. Got -3.0 instead."),
     ],
     ids=[
@@ -419,7 +422,7 @@ def test_config_error_is_a_value_error():
 def test_mu_max_moments_in_chunks_gives_the_bits_of_one_batch(monkeypatch):
     # The paper's 50 500 values of n in one batch took 2.8 GB; chunks must not change a bit.
     # Seed 0: 700 values of n spread over 0 to 5e7, three chunks of 256 against one batch.
-    from slidernet.analysis import theory as th
+    from slidernet.analysis.theory import extremes as th
     law = TruncatedBelow(Gaussian(0.6, 0.01), lower=0.5, name="gaussian")
     n = np.round(np.exp(np.random.default_rng(0).uniform(0.0, np.log(5e7), 700)))
     chunked = th.mu_max_moments(law, n)
