@@ -832,6 +832,8 @@ def choose_tilt_at(requested: str, pair_tilt: bool) -> str:
         :data:`PAIR_TILT_ONLY` (a validator's ValueError, which pydantic
         reports with the field names).
 
+    Examples
+    --------
     >>> choose_tilt_at("auto", True), choose_tilt_at("auto", False)
     ('rearrangements', 'records')
     """

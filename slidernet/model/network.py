@@ -385,6 +385,8 @@ def pair_tilt_applies(net: Network) -> bool:
     -------
     bool
 
+    Examples
+    --------
     >>> pair_tilt_applies(chain(2, Ntilde=1e-7, k=3.0)), pair_tilt_applies(chain(2, Ntilde=1e-7, f_ext=0.1))
     (True, False)
     """
