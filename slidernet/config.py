@@ -45,7 +45,8 @@ from pydantic import (
 
 from slidernet.errors import ConfigError, SlidernetError
 from slidernet.model import units
-from slidernet.model.network import Network
+from slidernet.model.builders import KIND_DIMS, build
+from slidernet.model.network import Network, pair_tilt_applies
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
@@ -178,10 +179,45 @@ class NetworkConfig(_Strict):
         """True if a nonzero f_ext or incline loads the sliders (known without a file)."""
         return bool(self.f_ext) or bool(self.incline)
 
+    def build(self) -> Network:
+        """The network (its own ``seed``: the geometry is quenched), with the incline's f_ext."""
+        params = self.model_dump(exclude={"kind", "Ntilde", "seed", "incline"}, exclude_none=True)
+        # seed None means 0, not fresh entropy: a network is part of the scene.
+        rng = np.random.Generator(np.random.PCG64(self.seed or 0))
+        net = build(self.kind, params, self.Ntilde, rng)
+        if self.incline:
+            # The downhill pull of gravity on a slider of normal load N_i: N_i tan(incline) along +x.
+            f_ext = np.zeros((net.n_nodes, net.dim))
+            f_ext[:, 0] = math.tan(math.radians(self.incline)) * net.normal_load
+            net.f_ext = f_ext
+        return net
+
+    def pair_network(self) -> Network | None:
+        """The network, built, where it may be a 1D pair of sliders; None where it cannot be one.
+
+        The checks of a configuration ask the network itself
+        (:meth:`Network.is_two_slider`, :func:`pair_tilt_applies`) rather
+        than its keys, so that they follow the rules the scene follows. The
+        kind and size rule most networks out without building them; a pair
+        costs nothing to build, and a graph's file is read. A file that
+        cannot be read gives None: building the scene reports it.
+        """
+        if KIND_DIMS[self.kind] == 2 or self.size() not in (2, None):
+            return None
+        try:
+            return self.build()
+        except (SlidernetError, OSError):
+            return None
+
+    def is_two_slider(self) -> bool:
+        """True for the paper's two sliders, which the pair kernel runs (:meth:`Network.is_two_slider`)."""
+        net = self.pair_network()
+        return net is not None and net.is_two_slider()
+
     def pair_tilt_applies(self) -> bool:
-        """True if the appendix's two-slider tilt test applies (when known without a file)."""
-        return (self.kind == "two_slider" or (self.kind == "chain" and self.n == 2)) \
-            and self.normal_load in (None, 1.0) and not self.tangential_load()
+        """True if the appendix's tilt test before every rearrangement applies (:func:`pair_tilt_applies`)."""
+        net = self.pair_network()
+        return net is not None and pair_tilt_applies(net)
 
     def size(self) -> int | None:
         """Number of sliders, when known without reading a file."""
@@ -502,12 +538,8 @@ class Config(_Strict):
             if any(t > self.steps for t in self.record):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         size = self.network.size()
-        if self.mu_eff_at == "rearrangements" and not self.network.pair_tilt_applies():
-            raise ValueError(
-                "'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every rearrangement) "
-                "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records' "
-                "(the network tilt test at the recorded times)"
-            )
+        if self.mu_eff_at == "rearrangements":  # the network is built only for this check, where it may be a pair
+            choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies())
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
         for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue")):
@@ -543,20 +575,12 @@ class Config(_Strict):
 
     def _network_dim_and_pair(self) -> tuple[int | None, bool]:
         """(dimension, runs on the pair kernel) of the network, reading a graph file only if there is one."""
-        net = self.network
-        if net.kind == "graph":
-            try:
-                built = build_network(self)
-            except (SlidernetError, OSError):
-                return None, False  # building the scene reports the file itself
-            kernel = choose_kernel(self.solver.kernel, built.is_two_slider(), built.dim,
-                                   self.needs_catalogue())
-            return built.dim, kernel == "pair"
-        dim = 1 if net.kind in ("two_slider", "chain") else 2
-        defaults = all(v in (None, 1.0) for v in (net.k, net.kappa, net.normal_load)) and not net.tangential_load()
-        two = net.kind == "two_slider" or (net.kind == "chain" and net.n == 2)
-        kernel = choose_kernel(self.solver.kernel, two and defaults, dim, self.needs_catalogue())
-        return dim, kernel == "pair"
+        pair = self.network.pair_network()  # a graph is built here, once
+        dim = pair.dim if pair is not None else KIND_DIMS[self.network.kind]
+        if dim is None:
+            return None, False  # a graph file that cannot be read: building the scene reports it
+        two = pair is not None and pair.is_two_slider()
+        return dim, choose_kernel(self.solver.kernel, two, dim, self.needs_catalogue()) == "pair"
 
     def needs_catalogue(self) -> bool:
         """True if the kernel keeps the event catalogue: for the observable 'events', or 'creep' (read from it)."""
@@ -750,19 +774,7 @@ def is_finite(x: float) -> bool:
 
 def build_network(cfg: Config) -> Network:
     """The network of the configured scene (its own seed: the geometry is quenched)."""
-    from slidernet.model.builders import build
-
-    net_cfg = cfg.network
-    params = net_cfg.model_dump(exclude={"kind", "Ntilde", "seed", "incline"}, exclude_none=True)
-    # seed None means 0, not fresh entropy: a network is part of the scene.
-    rng = np.random.Generator(np.random.PCG64(net_cfg.seed or 0))
-    net = build(net_cfg.kind, params, net_cfg.Ntilde, rng)
-    if net_cfg.incline:
-        # The downhill pull of gravity on a slider of normal load N_i: N_i tan(incline) along +x.
-        f_ext = np.zeros((net.n_nodes, net.dim))
-        f_ext[:, 0] = math.tan(math.radians(net_cfg.incline)) * net.normal_load
-        net.f_ext = f_ext
-    return net
+    return cfg.network.build()
 
 
 def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -> str:
@@ -784,3 +796,49 @@ def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -
     if two_slider and not catalogue:
         return "pair"
     return "csr" if dim == 1 else "vec"
+
+
+#: Why ``mu_eff_at = "rearrangements"`` is refused: the one message, from :func:`choose_tilt_at`.
+PAIR_TILT_ONLY = ("'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every rearrangement) "
+                  "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records' "
+                  "(the network tilt test at the recorded times)")
+
+
+def choose_tilt_at(requested: str, pair_tilt: bool) -> str:
+    """When the tilt test of mu_eff is made: the one rule, used by the scene and by the checks of a configuration.
+
+    ``auto`` gives ``"rearrangements"`` (the appendix's test before every
+    rearrangement) where it applies, ``"records"`` (the network tilt test at
+    the recorded times) elsewhere; a value named in ``mu_eff_at`` is returned
+    as it is, and ``"rearrangements"`` where the appendix's test does not
+    apply is refused.
+
+    Parameters
+    ----------
+    requested : {"auto", "rearrangements", "records"}
+        The configuration's ``mu_eff_at``.
+    pair_tilt : bool
+        The appendix's test applies to the network
+        (:func:`~slidernet.model.network.pair_tilt_applies`).
+
+    Returns
+    -------
+    {"rearrangements", "records"}
+
+    Raises
+    ------
+    ValueError
+        ``"rearrangements"`` without ``pair_tilt``; the message is
+        :data:`PAIR_TILT_ONLY` (a validator's ValueError, which pydantic
+        reports with the field names).
+
+    Examples
+    --------
+    >>> choose_tilt_at("auto", True), choose_tilt_at("auto", False)
+    ('rearrangements', 'records')
+    """
+    if requested == "auto":
+        return "rearrangements" if pair_tilt else "records"
+    if requested == "rearrangements" and not pair_tilt:
+        raise ValueError(PAIR_TILT_ONLY)
+    return requested

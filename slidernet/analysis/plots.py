@@ -439,13 +439,6 @@ class Overlay:
         return self.label if self.values is not None else f"{self.name}: not drawn ({self.reason})"
 
 
-def _is_two_slider(cfg: Config) -> bool:
-    """True for the paper's scene (reading a graph file only when its size is unknown)."""
-    from slidernet.config import build_network
-
-    return cfg.network.size() in (2, None) and build_network(cfg).is_two_slider()
-
-
 def theory_overlays(ds: xr.Dataset, config: Config | None = None) -> dict[str, Overlay]:
     r"""The paper's closed forms for a result, at its recorded times.
 
@@ -521,7 +514,7 @@ def theory_overlays(ds: xr.Dataset, config: Config | None = None) -> dict[str, O
         o = overlays[key]
         overlays[key] = Overlay(o.name, label or o.label, np.broadcast_to(values, t.shape).astype(float))
 
-    if not _is_two_slider(cfg):
+    if not cfg.network.is_two_slider():
         for key in overlays:
             skip(key, "two sliders only")
         return overlays

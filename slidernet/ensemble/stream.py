@@ -1,8 +1,10 @@
 """The ensemble's result file, written chunk by chunk as realizations come in.
 
 A run with an output directory streams its realizations to ``result.nc``:
-memory does not grow with the number of realizations, and the file is
-written atomically (a temporary file, then a rename).
+memory does not grow with the number of realizations. The reduction is
+here (it needs :mod:`slidernet.analysis.observables`, a stage above
+:mod:`slidernet.io`); the file itself, its encoding and its atomic write are
+:func:`slidernet.io.result_writer`'s, the same as :func:`slidernet.io.write_netcdf`'s.
 """
 
 from __future__ import annotations
@@ -12,18 +14,17 @@ from pathlib import Path
 
 import numpy as np
 
-from slidernet.io import atomic_output
+from slidernet.io import result_writer
 
 
 def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray, R: int,
                         observables: list[str], attrs: dict[str, str]) -> Path:
     """Write a result to netCDF chunk by chunk, atomically; memory does not grow with R.
 
-    The same variables and bits as :func:`slidernet.analysis.observables.assemble`
-    followed by :func:`write_netcdf`: the per-realization variables go to the
+    The same variables, bits and encoding as :func:`slidernet.analysis.observables.assemble`
+    followed by :func:`~slidernet.io.write_netcdf`: the per-realization variables go to the
     file one chunk of :data:`slidernet.analysis.observables.CHUNK` realizations at a
-    time (stored in chunks of that many realizations), the ensemble
-    statistics are reduced on the fly in the same chunks.
+    time, the ensemble statistics are reduced on the fly in the same chunks.
 
     Parameters
     ----------
@@ -32,61 +33,39 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
     path : path
         The netCDF file to write.
     t : ndarray of int, shape (T,)
-        Recorded times.
+        Recorded times, in tau_th.
     R : int
         Number of realizations.
     observables : list of str
         The requested observables.
     attrs : dict
         Global attributes.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
     """
-    import netCDF4
-
-    from slidernet.analysis.observables import CHUNK, EnsembleStats, chunks, coordinates, realization_variables
-
-    def create(nc, name: str, dims: str | tuple[str, ...], data: np.ndarray, var_attrs: dict) -> netCDF4.Variable:
-        dims = (dims,) if isinstance(dims, str) else tuple(dims)
-        for i, d in enumerate(dims):  # dimensions without a coordinate (node)
-            if d not in nc.dimensions:
-                # The creep events are padded to the most of any realization, known only at the end.
-                nc.createDimension(d, None if d == "creep_event" else data.shape[i])
-        fixed = {"realization": min(CHUNK, R), "event": 1 << 16, "creep_event": 256}
-        sizes = [fixed.get(d) or max(1, len(nc.dimensions[d])) for d in dims]
-        # Rows of creep events shorter than the dimension read NaN, as assemble pads them.
-        fill = np.nan if "creep_event" in dims else False
-        var = nc.createVariable(name, data.dtype, dims, fill_value=fill, chunksizes=sizes or None,
-                                contiguous=not dims)
-        var.setncatts(var_attrs)
-        return var
+    from slidernet.analysis.observables import EnsembleStats, chunks, coordinates, realization_variables
 
     path = Path(path)
-    with atomic_output(path) as tmp, netCDF4.Dataset(tmp, "w", format="NETCDF4") as nc:
+    with result_writer(path) as out:
         stats = EnsembleStats(observables, int(t[-1]))
         r0 = 0
         for chunk in chunks(records):
-            if r0 == 0:
+            if r0 == 0:  # the coordinates come whole, and first: they make the dimensions
                 for name, (dim, data, *rest) in coordinates(t, R, chunk[0]).items():
-                    if dim not in nc.dimensions:  # cycle_end shares the dimension cycle
-                        nc.createDimension(dim, data.size)
-                    create(nc, name, (dim,), data, rest[0] if rest else {})[:] = data
-                if "events" in chunk[0]:
-                    nc.createDimension("event", None)
-            variables = realization_variables(chunk, observables, r0)
-            offset = len(nc.dimensions["event"]) if "event" in nc.dimensions else 0
-            for name, (dims, data, var_attrs) in variables.items():
-                var = nc.variables[name] if name in nc.variables else create(nc, name, dims, data, var_attrs)
-                if dims in ("event", ("event",)):
-                    var[offset:offset + data.shape[0]] = data
-                elif "creep_event" in dims:
-                    var[r0:r0 + data.shape[0], :data.shape[1]] = data
-                else:
-                    var[r0:r0 + data.shape[0]] = data
+                    out.write(name, dim, data, rest[0] if rest else {}, coordinate=True)
+            # This chunk's slips go on where the previous chunk's ended; rows of creep
+            # events shorter than the longest so far read NaN, as assemble pads them.
+            start = {"realization": r0, "event": out.size("event")}
+            for name, (dims, data, var_attrs) in realization_variables(chunk, observables, r0).items():
+                out.write(name, dims, data, var_attrs, start=start)
             stats.add(chunk)
             r0 += len(chunk)
         if r0 != R:
             raise ValueError(f"write_result_stream got {r0} realizations, expected {R}")
         for name, (dims, data, var_attrs) in stats.finish().items():
-            data = np.asarray(data)
-            create(nc, name, dims, data, var_attrs)[...] = data
-        nc.setncatts(attrs)
+            out.write(name, dims, data, var_attrs)
+        out.set_attrs(attrs)
     return path

@@ -1,19 +1,48 @@
-"""Writing and reading result files (netCDF), atomically.
+"""Writing and reading result files (netCDF), atomically, in one encoding.
 
 A result is first written to a temporary file in the destination folder and
 then renamed over the target, so an interrupted run never leaves a partial
 ``result.nc``.
+
+Two writers make result files: :func:`write_netcdf` (a dataset in memory,
+through xarray) and :func:`result_writer` (a file written piece by piece
+with netCDF4, for a run streamed to disk chunk by chunk). Both store every
+variable as :func:`stored` and :func:`variable_encoding` say, so a file reads
+back the same whichever wrote it:
+
+- dtypes are kept: float64 as float64, int64 counts as int64 (never narrowed:
+  a run passes 2^31 slips), int8 as int8; a bool is stored as int8 with the
+  attribute ``dtype = "bool"`` (xarray's convention: it reads back as bool);
+  text as variable-length strings;
+- a float variable has ``_FillValue = NaN``: NaN is a value of the results
+  (``mu_eff`` where no test was pooled, a standard error of one realization,
+  the creep events' padding) and reads back as NaN, and a part of the file
+  never written (the padding of a row of creep events) reads NaN too; an
+  integer or a string has no fill value;
+- every variable with dimensions is chunked (:data:`CHUNKS`, at most
+  :data:`MAX_CHUNK_BYTES` a chunk), a scalar is contiguous; nothing is
+  compressed; ``event`` and ``creep_event`` are unlimited (:data:`UNLIMITED`:
+  a streamed run learns their lengths only at its end);
+- attributes are text or numbers (:func:`check_attrs`), written as netCDF4
+  writes them (a string as text, an int as int64, a float as float64); a
+  coordinate that is not a dimension's is named in the ``coordinates``
+  attribute of the variables it labels (CF, as xarray writes and reads it),
+  so that it reads back as a coordinate.
 """
 
 from __future__ import annotations
 
 import json
+import math
+import numbers
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import xarray as xr
 
 
@@ -45,11 +74,288 @@ def _umask() -> int:
     return mask
 
 
+#: Storage chunk along the dimensions a result grows or is read along; any other
+#: dimension is stored whole in each chunk. 1024 realizations is also the
+#: reduction chunk of a streamed run (``analysis.observables.CHUNK``), so each of
+#: its writes fills whole chunks; the event catalogue grows by 65536 slips a chunk.
+CHUNKS: dict[str, int] = {"realization": 1024, "event": 1 << 16, "creep_event": 256}
+
+#: Dimensions whose length a streamed run learns only at its end: unlimited in every result file.
+UNLIMITED: tuple[str, ...] = ("event", "creep_event")
+
+#: Largest chunk, in bytes: a quarter of netCDF's default chunk cache (64 MiB per
+#: variable, ``netCDF4.get_chunk_cache()``). Without it a chunk of 1024
+#: realizations of 1e5 recorded times would be 819 MB, read whole for one value.
+MAX_CHUNK_BYTES = 16 * 2**20
+
+
+def variable_encoding(dims: Sequence[str], shape: Sequence[int], dtype: np.dtype) -> dict[str, Any]:
+    """How one variable is stored: the one rule of both result writers.
+
+    Parameters
+    ----------
+    dims : sequence of str
+        The variable's dimensions.
+    shape : sequence of int
+        Their lengths in the file (a length along an unlimited dimension is
+        not used).
+    dtype : numpy.dtype
+        The data's dtype (a bool is stored as int8: :func:`stored`).
+
+    Returns
+    -------
+    dict
+        xarray's encoding keys for the netCDF4 engine: ``dtype`` (where this
+        rule sets it), ``_FillValue``, ``zlib``, ``contiguous`` and
+        ``chunksizes``. A dtype other than a number or text (dates, say) is
+        left to xarray's own conventions, and refused by :func:`result_writer`.
+
+    >>> variable_encoding(("realization", "t"), (3000, 41), np.dtype(np.int64))["chunksizes"]
+    (1024, 41)
+    >>> enc = variable_encoding(("t",), (41,), np.dtype(np.float64))
+    >>> enc["dtype"], bool(np.isnan(enc["_FillValue"]))
+    (dtype('float64'), True)
+    """
+    dtype = np.dtype(dtype)
+    enc: dict[str, Any] = {"zlib": False}
+    if dtype.kind == "f":
+        enc.update(dtype=dtype, _FillValue=dtype.type(np.nan))
+    elif dtype.kind in "iu":
+        enc.update(dtype=dtype, _FillValue=None)
+    elif dtype.kind == "b":
+        enc.update(dtype=np.dtype(np.int8), _FillValue=None)
+    elif dtype.kind == "U":
+        enc.update(dtype=str, _FillValue=None)
+    if not dims:
+        enc["contiguous"] = True
+        return enc
+    chunks = [CHUNKS[d] if d in UNLIMITED else max(1, min(CHUNKS.get(d, n), n))
+              for d, n in zip(dims, shape, strict=True)]
+    itemsize = dtype.itemsize if dtype.kind in "biuf" else 8  # text: one pointer per string
+    while math.prod(chunks) * itemsize > MAX_CHUNK_BYTES and max(chunks) > 1:
+        k = chunks.index(max(chunks))
+        chunks[k] = (chunks[k] + 1) // 2
+    enc.update(contiguous=False, chunksizes=tuple(chunks))
+    return enc
+
+
+_ATTR_TYPES = (str, bytes, numbers.Number, np.ndarray, list, tuple)
+
+
+def check_attrs(attrs: Mapping[str, Any], owner: str) -> None:
+    """Refuse an attribute netCDF cannot store: text, numbers and arrays or lists of them only.
+
+    A bool is refused too (netCDF has no bool attribute; xarray refuses
+    numpy's and netCDF4 Python's), so that a file never gets a number where
+    a flag was meant.
+
+    Raises
+    ------
+    TypeError
+        Naming the attribute, its owner and its value.
+    """
+    for key, value in attrs.items():
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, _ATTR_TYPES):
+            raise TypeError(f"The attribute {key!r} of {owner} cannot be stored in netCDF: {value!r} is a "
+                            f"{type(value).__name__}; give text or a number.")
+
+
+def stored(name: str, dims: Sequence[str], data: Any, attrs: Mapping[str, Any],
+           aux: Mapping[str, Sequence[str]]) -> tuple[Any, dict[str, Any]]:
+    """A variable's data and attributes as both writers store them.
+
+    Parameters
+    ----------
+    name : str
+    dims : sequence of str
+    data : array_like
+        Returned as it is, except a bool array, returned as int8.
+    attrs : mapping
+        The variable's attributes (checked by :func:`check_attrs`).
+    aux : mapping of str to sequence of str
+        The result's coordinates that are not a dimension's, with their
+        dimensions.
+
+    Returns
+    -------
+    data : array_like
+    attrs : dict
+        With ``dtype = "bool"`` for a bool, and ``coordinates``, the
+        coordinates of ``aux`` that label this variable (those whose
+        dimensions are all among its own; a coordinate lists none).
+    """
+    attrs = dict(attrs)
+    check_attrs(attrs, f"the variable {name!r}")
+    if not hasattr(data, "dtype"):
+        data = np.asarray(data)
+    if data.dtype == bool:
+        data = np.asarray(data).astype(np.int8)
+        attrs["dtype"] = "bool"
+    if name not in aux and name not in dims and "coordinates" not in attrs:
+        labels = sorted(c for c, c_dims in aux.items() if set(c_dims) <= set(dims))
+        if labels:
+            attrs["coordinates"] = " ".join(labels)
+    return data, attrs
+
+
 def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename)."""
+    """Write ``ds`` to ``path`` atomically (temporary file, then rename), in the results' encoding.
+
+    Every variable is stored as :func:`stored` and :func:`variable_encoding`
+    say, whatever encoding ``ds`` carries (a dataset read from a file
+    carries that file's): a file written here reads back as one written by
+    :func:`result_writer`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+    path : path
+        The file to write; missing folders are made.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    check_attrs(ds.attrs, "the dataset")
+    aux = {name: ds[name].dims for name in ds.coords if name not in ds.dims}
+    variables: dict[str, xr.Variable] = {}
+    encoding: dict[str, dict[str, Any]] = {}
+    for name, var in ds.variables.items():
+        data, attrs = stored(str(name), var.dims, var.values if var.dtype == bool else var.data, var.attrs, aux)
+        variables[name] = xr.Variable(var.dims, data, attrs)
+        encoding[name] = variable_encoding(var.dims, var.shape, variables[name].dtype)
+    out = xr.Dataset({n: v for n, v in variables.items() if n not in ds.coords},
+                     coords={n: v for n, v in variables.items() if n in ds.coords}, attrs=ds.attrs)
     with atomic_output(path) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4")
+        out.to_netcdf(tmp, engine="netcdf4", encoding=encoding,
+                      unlimited_dims=[d for d in UNLIMITED if d in out.dims])
     return Path(path)
+
+
+class ResultWriter:
+    """An open result file, written variable by variable and piece by piece (netCDF4).
+
+    Made by :func:`result_writer`, which writes it atomically. Each
+    variable is created by its first :meth:`write`, stored as
+    :func:`write_netcdf` stores it; its dimensions are created with the
+    variable's first data (unlimited for :data:`UNLIMITED`), so a dimension
+    must first come whole: write the coordinates first.
+    """
+
+    def __init__(self, nc: Any) -> None:
+        self._nc = nc
+        self._aux: dict[str, tuple[str, ...]] = {}  # coordinates that are not a dimension's
+        self._labelled: set[str] = set()  # those named by some variable's 'coordinates'
+
+    def size(self, dim: str) -> int:
+        """The length of ``dim`` so far (0 before it exists)."""
+        return len(self._nc.dimensions[dim]) if dim in self._nc.dimensions else 0
+
+    def write(self, name: str, dims: str | Sequence[str], data: Any, attrs: Mapping[str, Any] | None = None, *,
+              start: Mapping[str, int] | None = None, coordinate: bool = False) -> None:
+        """Write ``data`` into the variable ``name``, created first if it is new.
+
+        Parameters
+        ----------
+        name : str
+        dims : str or sequence of str
+            The variable's dimensions (a str for one).
+        data : array_like
+            Of one length per dimension; its place along each dimension starts
+            at ``start[dim]`` (default 0), so that a piece can extend an
+            unlimited dimension.
+        attrs : mapping, optional
+            The variable's attributes, used where it is created.
+        start : mapping of str to int, optional
+            Offsets along the dimensions; dimensions the variable does not
+            have are ignored.
+        coordinate : bool
+            The variable is a coordinate: one that is not a dimension's
+            (``name`` not in ``dims``) is named in the ``coordinates``
+            attribute of the variables created after it that it labels.
+        """
+        dims = (dims,) if isinstance(dims, str) else tuple(dims)
+        data = np.asarray(data)
+        if name not in self._nc.variables:
+            self._create(name, dims, data, attrs or {}, coordinate)
+        var = self._nc.variables[name]
+        start = start or {}
+        if data.dtype == bool:
+            data = data.astype(np.int8)
+        at = tuple(slice(start.get(d, 0), start.get(d, 0) + n) for d, n in zip(dims, data.shape, strict=True))
+        var[at if dims else ...] = data
+
+    def _create(self, name: str, dims: tuple[str, ...], data: np.ndarray, attrs: Mapping[str, Any],
+                coordinate: bool) -> None:
+        if data.dtype.kind not in "biufU":
+            raise TypeError(f"The variable {name!r} has dtype {data.dtype}, which a result file does not store "
+                            "(numbers, bools and text only).")
+        for d, n in zip(dims, data.shape, strict=True):
+            if d not in self._nc.dimensions:
+                self._nc.createDimension(d, None if d in UNLIMITED else n)
+        data, attrs = stored(name, dims, data, attrs, self._aux)
+        enc = variable_encoding(dims, [self.size(d) for d in dims], data.dtype)
+        var = self._nc.createVariable(name, enc.get("dtype", data.dtype), dims, zlib=enc["zlib"],
+                                      contiguous=enc["contiguous"], chunksizes=enc.get("chunksizes"),
+                                      fill_value=enc["_FillValue"])
+        for key, value in attrs.items():
+            _set_attribute(var, key, value)
+        self._labelled.update(attrs.get("coordinates", "").split())
+        if coordinate and name not in dims:
+            self._aux[name] = dims
+
+    def set_attrs(self, attrs: Mapping[str, Any]) -> None:
+        """Set the file's global attributes (checked by :func:`check_attrs`)."""
+        check_attrs(attrs, "the dataset")
+        for key, value in attrs.items():
+            _set_attribute(self._nc, key, value)
+
+    def _finish(self) -> None:
+        # A coordinate that labels no variable is named in a global 'coordinates', as xarray writes it.
+        unlabelled = sorted(set(self._aux) - self._labelled)
+        if unlabelled:
+            self._nc.setncattr("coordinates", " ".join(unlabelled))
+
+
+def _set_attribute(obj: Any, key: str, value: Any) -> None:
+    """Set one attribute as xarray's netCDF4 backend does: a list of strings as strings, anything else as given."""
+    if isinstance(value, (list, tuple)) and value and all(isinstance(v, str) for v in value):
+        obj.setncattr_string(key, value)
+    else:
+        obj.setncattr(key, value)
+
+
+@contextmanager
+def result_writer(path: str | Path) -> Iterator[ResultWriter]:
+    """Write a result file piece by piece, atomically: a :class:`ResultWriter` on a temporary file.
+
+    The file is renamed over ``path`` when the block ends, and removed
+    instead on any exception (Ctrl-C included): ``path`` is never half
+    written.
+
+    Parameters
+    ----------
+    path : path
+        The file to write; missing folders are made.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "result.nc"
+    >>> with result_writer(path) as out:
+    ...     out.write("realization", "realization", np.arange(3), coordinate=True)
+    ...     for r in range(3):
+    ...         out.write("n", "realization", [10 * r], {"units": "1"}, start={"realization": r})
+    >>> read_result(path)["n"].values.tolist()
+    [0, 10, 20]
+    """
+    import netCDF4
+
+    with atomic_output(path) as tmp, netCDF4.Dataset(tmp, "w", format="NETCDF4") as nc:
+        writer = ResultWriter(nc)
+        yield writer
+        writer._finish()
 
 
 def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:

@@ -48,6 +48,7 @@ from slidernet.model.network import Network, chain
 
 __all__ = [
     "KINDS",
+    "KIND_DIMS",
     "build",
     "from_graph",
     "irregular",
@@ -65,6 +66,17 @@ KINDS: dict[str, tuple[str, ...]] = {
     "triangular": ("shape",),
     "irregular": ("n",),
     "graph": ("path",),
+}
+
+#: The dimension of each kind's networks, known before building one; None for a
+#: graph, whose file says (1 or 2 coordinates per node).
+KIND_DIMS: dict[str, int | None] = {
+    "two_slider": 1,
+    "chain": 1,
+    "square": 2,
+    "triangular": 2,
+    "irregular": 2,
+    "graph": None,
 }
 
 # Per-spring or per-slider values a builder passes on to Network.

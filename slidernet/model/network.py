@@ -282,17 +282,24 @@ class Network:
         return g.reshape(-1)
 
     def is_two_slider(self) -> bool:
-        """True for the paper's scene: 2 sliders, one spring, all values at their defaults."""
+        """True for the paper's scene, which the two-slider kernel (``kernels.pair``) runs.
+
+        The one rule for that kernel: a pair to which the appendix's tilt
+        test applies (:func:`pair_tilt_applies`) with one spring of unit
+        length, stiffness and dilation between node 0 and node 1 at X = 0
+        and X = 1. The kernel works on scalars with F = theta - u and these
+        values built in, so any other value needs the general kernels.
+
+        >>> chain(2, Ntilde=1e-7).is_two_slider(), chain(2, Ntilde=1e-7, k=2.0).is_two_slider()
+        (True, False)
+        """
         return (
-            self.n_nodes == 2
-            and self.dim == 1
+            pair_tilt_applies(self)
             and self.n_edges == 1
             and self.positions[1, 0] - self.positions[0, 0] == 1.0
             and self.rest_length[0] == 1.0
             and tuple(self.edges[0]) == (0, 1)
             and bool((self.k == 1.0).all() and (self.kappa == 1.0).all())
-            and bool((self.normal_load == 1.0).all())
-            and not self.f_ext.any()
         )
 
     def to_networkx(self) -> nx.Graph:
@@ -358,6 +365,33 @@ class Network:
 
     def __repr__(self) -> str:
         return f"Network(N={self.n_nodes}, E={self.n_edges}, Ntilde={self.Ntilde!r})"
+
+
+def pair_tilt_applies(net: Network) -> bool:
+    """True if the appendix's tilt test before every rearrangement (``kernels.tilt``) applies to ``net``.
+
+    The one rule for that test (``mu_eff_at = "rearrangements"``): two
+    sliders on a line, each of unit normal load, with no force but the
+    springs' (no f_ext, no incline). The appendix writes it for that pair
+    alone; any other network takes the network tilt test at the recorded
+    times. Springs and geometry do not enter: the test reads the forces and
+    the thresholds only.
+
+    Parameters
+    ----------
+    net : Network
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> pair_tilt_applies(chain(2, Ntilde=1e-7, k=3.0)), pair_tilt_applies(chain(2, Ntilde=1e-7, f_ext=0.1))
+    (True, False)
+    """
+    return (net.n_nodes == 2 and net.dim == 1 and bool((net.normal_load == 1.0).all())
+            and not net.f_ext.any())
 
 
 def _node_force(data: dict, d: int, node) -> list[float]:

@@ -8,11 +8,11 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from slidernet.config import Config, build_network, choose_kernel
+from slidernet.config import Config, build_network, choose_kernel, choose_tilt_at
 from slidernet.errors import ConfigError
 from slidernet.kernels import Chain, Plane, Settings
 from slidernet.kernels.assembly import diagonal_positions
-from slidernet.model.network import Network
+from slidernet.model.network import Network, pair_tilt_applies
 from slidernet.solver.creep import CreepSpec, reference_slip
 
 
@@ -181,20 +181,18 @@ class Scene:
         net = build_network(cfg) if network is None else network
         family, operators = _operators(net)
         catalogue = cfg.needs_catalogue()
-        kernel = choose_kernel(cfg.solver.kernel, net.is_two_slider(), net.dim, catalogue)
-        if kernel != family and not (kernel == "pair" and net.is_two_slider()):
+        two_slider = net.is_two_slider()
+        kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, catalogue)
+        if kernel != family and not (kernel == "pair" and two_slider):
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
             )
         tilt_at = None
         if "mu_eff" in cfg.observables:
-            pair = pair_tilt_applies(net)
-            tilt_at = cfg.mu_eff_at if cfg.mu_eff_at != "auto" else ("rearrangements" if pair else "records")
-            if tilt_at == "rearrangements" and not pair:
-                raise ConfigError(
-                    "The 'mu_eff_at' field: the tilt test before every rearrangement (the appendix) "
-                    "needs a 1D pair of sliders with unit normal loads and no f_ext; use 'records'."
-                )
+            try:
+                tilt_at = choose_tilt_at(cfg.mu_eff_at, pair_tilt_applies(net))
+            except ValueError as exc:  # a network given here that the configuration's checks never saw
+                raise ConfigError(f"The 'mu_eff_at' field: {exc}.") from None
         slide_away = mean_load(net) > cfg.friction.mu_d
         return cls(
             network=net,
@@ -249,16 +247,6 @@ def mean_load(net: Network) -> float:
     0.55
     """
     return float(net.f_ext[:, 0].sum() / net.normal_load.sum())
-
-
-def pair_tilt_applies(net: Network) -> bool:
-    """True if the appendix's two-slider tilt test (``kernels.tilt_test_pair``) applies to ``net``.
-
-    It is written for two sliders of unit normal load on a line, with no force
-    but the spring's.
-    """
-    return (net.n_nodes == 2 and net.dim == 1 and bool((net.normal_load == 1.0).all())
-            and not net.f_ext.any())
 
 
 def _tilt_operators(net: Network, operators: Chain | Plane) -> TiltOperators:
