@@ -63,42 +63,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import special, stats
 
-from slidernet._validation import checked_output
+from slidernet._validation import check_array, check_scalar, checked_output
 from slidernet.errors import ConfigError, param_error
 from slidernet.kernels import draws
 
 # The least probability a law may put above mu_d (check_mu_d): rejection
 # sampling then costs at most 1000 draws per accepted threshold.
 MIN_MASS = 1e-3
-
-
-def _check_finite_positive(value: float, param: str, owner: str) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0:
-        raise param_error(param, owner, "finite and > 0", value)
-    return value
-
-
-def _check_finite(value: float, param: str, owner: str) -> float:
-    try:
-        out = float(value)
-    except (TypeError, ValueError):
-        raise param_error(param, owner, "a finite number", value) from None
-    if not math.isfinite(out):
-        raise param_error(param, owner, "finite", out)
-    return out
-
-
-def _check_m(m: ArrayLike) -> np.ndarray:
-    """The number(s) of draws as a float array, each finite and >= 1."""
-    try:
-        arr = np.asarray(m, dtype=float)
-    except (TypeError, ValueError):
-        raise param_error("m", "mean_max", "a number >= 1 or an array of them", m) from None
-    bad = ~(np.isfinite(arr) & (arr >= 1))
-    if bad.any():
-        raise param_error("m", "mean_max", "finite and >= 1", float(arr[bad].flat[0]))
-    return arr
 
 
 # ---------------------------------------------------------------------------
@@ -161,7 +132,7 @@ def mean_max_quadrature(dist: Distribution, m: ArrayLike) -> np.ndarray:
     >>> round(float(mean_max_quadrature(Uniform(0.5, 0.7), 3)), 12)  # 0.5 + 0.2 * 3 / 4
     0.65
     """
-    m_arr = _check_m(m)
+    m_arr = check_array(m, "m", "mean_max", ">= 1")
     log_u = _TS_LOG_P / m_arr[..., None]  # log p^{1/m}
     s = -np.expm1(log_u)  # 1 - p^{1/m}
     upper = s < 0.5
@@ -356,11 +327,8 @@ class Gaussian(Distribution):
     _mu_d_param = "mean"
 
     def __init__(self, mean: float, std: float) -> None:
-        mean = float(mean)
-        if not math.isfinite(mean):
-            raise param_error("mean", "gaussian", "finite", mean)
-        self.mean = mean
-        self.std = _check_finite_positive(std, "std", "gaussian")
+        self.mean = check_scalar(mean, "mean", "gaussian")
+        self.std = check_scalar(std, "std", "gaussian", "> 0")
 
     def _params(self) -> dict[str, Any]:
         return {"mean": self.mean, "std": self.std}
@@ -430,8 +398,8 @@ class Uniform(Distribution):
     _mu_d_param = "high"
 
     def __init__(self, low: float, high: float) -> None:
-        self.low = _check_finite(low, "low", "uniform")
-        self.high = _check_finite(high, "high", "uniform")
+        self.low = check_scalar(low, "low", "uniform")
+        self.high = check_scalar(high, "high", "uniform")
         if not self.high > self.low:
             raise param_error("high", "uniform", f"> low = {self.low!r}", self.high)
         self.width = self.high - self.low
@@ -468,7 +436,7 @@ class Uniform(Distribution):
 
     def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """Closed form a + (high - a) m / (m + 1), a = max(low, lower); see :meth:`Distribution.mean_max_above`."""
-        m_arr = _check_m(m)
+        m_arr = check_array(m, "m", "mean_max", ">= 1")
         a = max(self.low, float(lower))
         if a >= self.high:
             raise param_error("high", self.name, f"> lower = {lower!r}", self.high)
@@ -504,7 +472,7 @@ class Constant(Distribution):
     _mu_d_param = "value"
 
     def __init__(self, value: float) -> None:
-        self.value = _check_finite(value, "value", "constant")
+        self.value = check_scalar(value, "value", "constant")
 
     def _params(self) -> dict[str, Any]:
         return {"value": self.value}
@@ -540,7 +508,7 @@ class Constant(Distribution):
 
     def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """``value``, whatever m (above ``lower``)."""
-        m_arr = _check_m(m)
+        m_arr = check_array(m, "m", "mean_max", ">= 1")
         if not self.value > float(lower):
             raise param_error("value", self.name, f"> lower = {lower!r}", self.value)
         return np.full(m_arr.shape, self.value)
@@ -578,9 +546,9 @@ class Weibull(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"shape": 2.0, "scale": 0.15, "loc": 0.4}
 
     def __init__(self, shape: float, scale: float, loc: float = 0.0) -> None:
-        self.shape = _check_finite_positive(shape, "shape", "weibull")
-        self.scale = _check_finite_positive(scale, "scale", "weibull")
-        self.loc = _check_finite(loc, "loc", "weibull")
+        self.shape = check_scalar(shape, "shape", "weibull", "> 0")
+        self.scale = check_scalar(scale, "scale", "weibull", "> 0")
+        self.loc = check_scalar(loc, "loc", "weibull")
 
     def _params(self) -> dict[str, Any]:
         return {"shape": self.shape, "scale": self.scale, "loc": self.loc}
@@ -647,9 +615,9 @@ class Lognormal(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"median": 0.1, "sigma": 0.5, "loc": 0.45}
 
     def __init__(self, median: float, sigma: float, loc: float = 0.0) -> None:
-        self.median = _check_finite_positive(median, "median", "lognormal")
-        self.sigma = _check_finite_positive(sigma, "sigma", "lognormal")
-        self.loc = _check_finite(loc, "loc", "lognormal")
+        self.median = check_scalar(median, "median", "lognormal", "> 0")
+        self.sigma = check_scalar(sigma, "sigma", "lognormal", "> 0")
+        self.loc = check_scalar(loc, "loc", "lognormal")
 
     def _params(self) -> dict[str, Any]:
         return {"median": self.median, "sigma": self.sigma, "loc": self.loc}
@@ -714,8 +682,8 @@ class Exponential(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"scale": 0.05, "loc": 0.45}
 
     def __init__(self, scale: float, loc: float = 0.0) -> None:
-        self.scale = _check_finite_positive(scale, "scale", "exponential")
-        self.loc = _check_finite(loc, "loc", "exponential")
+        self.scale = check_scalar(scale, "scale", "exponential", "> 0")
+        self.loc = check_scalar(loc, "loc", "exponential")
 
     def _params(self) -> dict[str, Any]:
         return {"scale": self.scale, "loc": self.loc}
@@ -752,7 +720,7 @@ class Exponential(Distribution):
 
     def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """Closed form: a + scale H_m, a = max(loc, lower); see :meth:`Distribution.mean_max_above`."""
-        m_arr = _check_m(m)
+        m_arr = check_array(m, "m", "mean_max", ">= 1")
         a = max(self.loc, float(lower))
         # H_m = psi(m + 1) + gamma, also for non-integer m.
         return a + self.scale * (special.digamma(m_arr + 1.0) + np.euler_gamma)
@@ -791,9 +759,9 @@ class Pareto(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"alpha": 3.0, "scale": 0.05, "loc": 0.5}
 
     def __init__(self, alpha: float, scale: float, loc: float = 0.0) -> None:
-        self.alpha = _check_finite_positive(alpha, "alpha", "pareto")
-        self.scale = _check_finite_positive(scale, "scale", "pareto")
-        self.loc = _check_finite(loc, "loc", "pareto")
+        self.alpha = check_scalar(alpha, "alpha", "pareto", "> 0")
+        self.scale = check_scalar(scale, "scale", "pareto", "> 0")
+        self.loc = check_scalar(loc, "loc", "pareto")
 
     def _params(self) -> dict[str, Any]:
         return {"alpha": self.alpha, "scale": self.scale, "loc": self.loc}
@@ -828,7 +796,7 @@ class Pareto(Distribution):
 
     def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """Closed form (inf for alpha <= 1); see the class docstring and :meth:`Distribution.mean_max_above`."""
-        m_arr = _check_m(m)
+        m_arr = check_array(m, "m", "mean_max", ">= 1")
         s = max(self.scale, float(lower) - self.loc)
         if self.alpha <= 1.0:
             return np.full(m_arr.shape, math.inf)
@@ -979,7 +947,7 @@ class Empirical(Distribution):
 
     def mean_max_above(self, m: ArrayLike, lower: float) -> np.ndarray:
         """Exact for the ECDF: sum_k v_(k) [(k/K)^m - ((k-1)/K)^m]; see :meth:`Distribution.mean_max_above`."""
-        m_arr = _check_m(m)
+        m_arr = check_array(m, "m", "mean_max", ">= 1")
         v = self.values[self.values > float(lower)]
         if v.size == 0:
             raise param_error("path", self.name, f"a file with values > lower = {lower!r}", self.path)
@@ -1038,8 +1006,8 @@ distribution of scipy.stats (e.g. 'gamma'). Got 'poisson' instead.
         if not isinstance(params, Mapping) or not all(isinstance(k, str) for k in params):
             raise param_error("params", "scipy", "a table of named parameters", params)
         for key, value in params.items():
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise param_error("params", "scipy", f"finite numbers (the {key!r} entry)", dict(params))
+            # Checked only: scipy is given the values as written, as before.
+            check_scalar(value, f"params.{key}", "scipy")
         wanted = f"the parameters of scipy.stats.{dist} ({law.shapes + ', ' if law.shapes else ''}loc, scale)"
         try:
             frozen = law(**params)
@@ -1084,7 +1052,7 @@ distribution of scipy.stats (e.g. 'gamma'). Got 'poisson' instead.
         """By quadrature; inf where scipy says the law's mean is infinite, NaN where undefined."""
         mean = float(self.frozen.mean())
         if not math.isfinite(mean):
-            return np.full(_check_m(m).shape, mean if mean == math.inf else math.nan)
+            return np.full(check_array(m, "m", "mean_max", ">= 1").shape, mean if mean == math.inf else math.nan)
         return super().mean_max_above(m, lower)
 
 
