@@ -21,8 +21,8 @@ from hypothesis import strategies as st
 import slidernet
 from slidernet.config import load_config
 from slidernet.errors import ConfigError, PluginError
-from slidernet.plugins import distributions
 from slidernet.plugins.distributions import RAW_CHUNK, Gaussian, TruncatedBelow, TruncatedStream
+from slidernet.plugins.distributions import stream as threshold_stream
 from slidernet.solver import Realization, Scene, realization_streams, simulate
 from tests.conftest import make_config
 
@@ -177,7 +177,7 @@ def test_a_stream_draws_nothing_before_it_is_read() -> None:
 
 def test_a_stream_crosses_chunk_boundaries_whatever_it_is_asked(monkeypatch: pytest.MonkeyPatch) -> None:
     # Chunks of 8 raw draws, about 4 accepted each: requests span several chunks.
-    monkeypatch.setattr(distributions, "RAW_CHUNK", 8)
+    monkeypatch.setattr(threshold_stream, "RAW_CHUNK", 8)  # read where TruncatedStream is
     law = TruncatedBelow(Recording(), MU_D, "recording")
     one = TruncatedStream(law, np.random.default_rng(5))
     mixed = TruncatedStream(law, np.random.default_rng(5))

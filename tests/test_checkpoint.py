@@ -14,7 +14,7 @@ import pytest
 from slidernet.config import load_config
 from slidernet.errors import CheckpointError
 from slidernet.io.checkpoint import checkpoint_info, load_realization, save_realization
-from slidernet.plugins import distributions
+from slidernet.plugins.distributions import stream as threshold_stream
 from slidernet.solver import Realization, Scene, simulate
 from slidernet.solver import backends as backends_module
 
@@ -59,7 +59,7 @@ def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(backends_module, "EVENT_CHUNK", 64)
     # Raw threshold chunks of 64 draws: the streams' Generators have moved past
     # their first chunk, and hold a surplus, at the checkpoint.
-    monkeypatch.setattr(distributions, "RAW_CHUNK", 64)
+    monkeypatch.setattr(threshold_stream, "RAW_CHUNK", 64)  # read where TruncatedStream is
 
 
 def fresh_scene(name: str) -> Scene:

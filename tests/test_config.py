@@ -56,7 +56,8 @@ BAD_VALUES = [
     ("driver.sigma_theta", -1e-6, r"'driver' field: The 'sigma_theta' parameter of gaussian_steps must be > 0"),
     ("driver.sigma_theta", math.nan,
      r"'sigma_theta' parameter of gaussian_steps must be finite and > 0\. Got nan"),
-    ("friction.static.std", -0.01, r"'friction\.static' field: The 'std' parameter of gaussian must be finite"),
+    ("friction.static.std", -0.01,
+     r"'friction\.static' field: The 'std' parameter of gaussian must be > 0\. Got -0\.01"),
     ("friction.static.std", math.nan, r"'std' parameter of gaussian must be finite and > 0\. Got nan"),
     ("friction.static.mean", math.nan, r"'mean' parameter of gaussian must be finite\. Got nan"),
     ("friction.static.mean", 0.5, r"'mean' parameter of gaussian must be > mu_d = 0\.5\. Got 0\.5"),
@@ -309,3 +310,61 @@ def test_toml_with_a_bad_value_names_the_field(tmp_path):
     path.write_text(REFERENCE_TOML.replace("mu_d = 0.5", "mu_d = -0.5"))
     with pytest.raises(ConfigError, match=r"'friction\.mu_d' field must be > 0"):
         load_config(path)
+
+
+# One rule for every real parameter of a plugin (slidernet._validation.check_scalar): an int or a float,
+# never a boolean, a string (even one that reads as a number) or an array. A law of mu_s and a driver
+# answer alike: the library with a ConfigError, the command line with one line naming the field, exit 2.
+# (id, table, its body in the TOML file, pattern of the message after the field's name)
+NOT_REAL = [
+    ("gaussian-std-text", "friction.static", 'name = "gaussian"\nmean = 0.6\nstd = "abc"',
+     r"The 'std' parameter of gaussian must be a real number > 0\. Got 'abc' instead\."),
+    ("gaussian-std-number-as-text", "friction.static", 'name = "gaussian"\nmean = 0.6\nstd = "0.1"',
+     r"The 'std' parameter of gaussian must be a real number > 0\. Got '0\.1' instead\."),
+    ("gaussian-std-array", "friction.static", 'name = "gaussian"\nmean = 0.6\nstd = [0.1]',
+     r"The 'std' parameter of gaussian must be a real number > 0\. Got \[0\.1\] instead\."),
+    ("gaussian-std-boolean", "friction.static", 'name = "gaussian"\nmean = 0.6\nstd = true',
+     r"The 'std' parameter of gaussian must be a real number > 0\. Got True instead\."),
+    ("gaussian-mean-text", "friction.static", 'name = "gaussian"\nmean = "0.6"\nstd = 0.01',
+     r"The 'mean' parameter of gaussian must be a real number\. Got '0\.6' instead\."),
+    ("weibull-shape-boolean", "friction.static", 'name = "weibull"\nshape = true\nscale = 0.15\nloc = 0.4',
+     r"The 'shape' parameter of weibull must be a real number > 0\. Got True instead\."),
+    ("uniform-low-text", "friction.static", 'name = "uniform"\nlow = "0.45"\nhigh = 0.65',
+     r"The 'low' parameter of uniform must be a real number\. Got '0\.45' instead\."),
+    ("empirical-column-float", "friction.static", 'name = "empirical"\npath = "mu_s.txt"\ncolumn = 1.5',
+     r"The 'column' parameter of empirical must be a column index \(int\) or a header name \(str\)\."),
+    ("scipy-param-text", "friction.static",
+     'name = "scipy"\ndist = "gamma"\nparams = { a = "2", loc = 0.45, scale = 0.05 }',
+     r"The 'params\.a' parameter of scipy must be a real number\. Got '2' instead\."),
+    ("driver-sigma_theta-text", "driver", 'name = "gaussian_steps"\nsigma_theta = "1e-6"',
+     r"The 'sigma_theta' parameter of gaussian_steps must be a real number > 0\. Got '1e-6' instead\."),
+    ("driver-period-boolean", "driver", 'name = "sinusoidal"\namplitude = 1e-6\nperiod = true',
+     r"The 'period' parameter of sinusoidal must be a real number > 0\. Got True instead\."),
+]
+
+
+def _toml_with(table: str, body: str) -> str:
+    """REFERENCE_TOML, its ``[table]`` holding ``body`` instead."""
+    pattern = rf"^\[{re.escape(table)}\][^\n]*\n.*?(?=^\[|\Z)"
+    text, count = re.subn(pattern, lambda _: f"[{table}]\n{body}\n\n", REFERENCE_TOML, flags=re.M | re.S)
+    assert count == 1
+    return text.replace("steps = 10000", "steps = 10").replace("realizations = 200", "realizations = 1")
+
+
+@pytest.mark.parametrize(("table", "body", "match"), [c[1:] for c in NOT_REAL], ids=[c[0] for c in NOT_REAL])
+def test_a_parameter_that_is_not_a_real_number_is_one_line_naming_it(table, body, match, tmp_path, capsys):
+    from slidernet.cli import main
+
+    path = tmp_path / "bad.toml"
+    path.write_text(_toml_with(table, body))
+    with pytest.raises(ConfigError, match=rf"^The '{re.escape(table)}' field: {match}"):
+        load_config(path)
+    out = tmp_path / "out"
+    status = main(["run", str(path), "--out", str(out), "--no-progress"])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert re.match(rf"slidernet: error: The '{re.escape(table)}' field: {match}", lines[0]), lines[0]
+    assert not out.exists()

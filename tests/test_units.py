@@ -142,8 +142,9 @@ CALLS = {
     "conductivity": lambda v: units.tau_th(rho=1e3, heat_capacity=1e3, conductivity=v, size=0.1),
     "heat_capacity": lambda v: units.tau_th(rho=1e3, heat_capacity=v, conductivity=1.0, size=0.1),
 }
-BAD = [(-1, "> 0", "-1"), (0.0, "> 0", "0.0"), (math.nan, "finite and > 0", "nan"),
-       (math.inf, "finite and > 0", "inf"), ("x", "a number", "'x'"), (True, "a number", "True")]
+BAD = [(-1, "> 0", "-1.0"), (0.0, "> 0", "0.0"), (math.nan, "finite and > 0", "nan"),
+       (math.inf, "finite and > 0", "inf"), ("x", "a real number > 0", "'x'"), (True, "a real number > 0", "True"),
+       ("0.1", "a real number > 0", "'0.1'")]
 
 
 @pytest.mark.parametrize("param", sorted(CALLS))
@@ -156,7 +157,7 @@ def test_bad_values_are_named(param, value, requirement, shown):
 
 
 def test_material_validates_its_values():
-    with pytest.raises(ConfigError, match=r"^The 'Y' parameter of units must be > 0\. Got -1 instead\.$"):
+    with pytest.raises(ConfigError, match=r"^The 'Y' parameter of units must be > 0\. Got -1\.0 instead\.$"):
         units.Material("bad", rho=1e3, Y=-1)
     with pytest.raises(ConfigError, match=r"'heat_capacity' parameter of units must be finite"):
         units.MATERIALS["glass"].replace(heat_capacity=math.inf)

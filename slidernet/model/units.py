@@ -36,10 +36,10 @@ Examples
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 
-from slidernet.errors import ConfigError, param_error
+from slidernet._validation import check_scalar
+from slidernet.errors import ConfigError
 
 #: Standard gravity, m/s^2.
 G_STANDARD = 9.81
@@ -47,25 +47,15 @@ G_STANDARD = 9.81
 _OWNER = "units"
 
 
-def _positive(value: object, param: str, owner: str = _OWNER) -> float:
-    """``value`` as a float, refused with a message naming ``param`` unless finite and > 0.
+def _positive(value: object, param: str) -> float:
+    """``value`` as a float, refused with a message naming ``param`` unless a finite real number > 0.
 
     >>> _positive(-1, "Y")
     Traceback (most recent call last):
     ...
-    slidernet.errors.ConfigError: The 'Y' parameter of units must be > 0. Got -1 instead.
+    slidernet.errors.ConfigError: The 'Y' parameter of units must be > 0. Got -1.0 instead.
     """
-    if isinstance(value, bool):
-        raise param_error(param, owner, "a number", value)
-    try:
-        x = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise param_error(param, owner, "a number", value) from None
-    if not math.isfinite(x):
-        raise param_error(param, owner, "finite and > 0", value)
-    if x <= 0:
-        raise param_error(param, owner, "> 0", value)
-    return x
+    return check_scalar(value, param, _OWNER, "> 0")
 
 
 def ntilde(rho: float, Y: float, size: float, g: float = G_STANDARD) -> float:
@@ -181,7 +171,7 @@ class Material:
     >>> Material("bad", rho=1e3, Y=-1)
     Traceback (most recent call last):
     ...
-    slidernet.errors.ConfigError: The 'Y' parameter of units must be > 0. Got -1 instead.
+    slidernet.errors.ConfigError: The 'Y' parameter of units must be > 0. Got -1.0 instead.
     """
 
     name: str

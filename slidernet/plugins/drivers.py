@@ -27,46 +27,15 @@ from __future__ import annotations
 
 import csv
 import math
-import numbers
 import os
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
+from slidernet._validation import check_scalar
 from slidernet.errors import ConfigError, param_error
 from slidernet.kernels.state import cached_jit
-
-_TESTS = {
-    "finite": lambda x: True,
-    "> 0": lambda x: x > 0,
-    ">= 0": lambda x: x >= 0,
-    "!= 0": lambda x: x != 0,
-}
-
-
-def _real(value: object, param: str, owner: str, requirement: str = "finite") -> float:
-    """``value`` as a float, refused unless it is a finite real number meeting ``requirement``.
-
-    ``requirement`` is one of ``"finite"``, ``"> 0"``, ``">= 0"`` and ``"!= 0"``.
-
-    >>> _real(2, "period", "sinusoidal", "> 0")
-    2.0
-    >>> _real("1", "period", "sinusoidal", "> 0")
-    Traceback (most recent call last):
-    ...
-    slidernet.errors.ConfigError: The 'period' parameter of sinusoidal must be a real number > 0. Got '1' instead.
-    """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        kind = "a real number" if requirement == "finite" else f"a real number {requirement}"
-        raise param_error(param, owner, kind, value)
-    x = float(value)
-    if not math.isfinite(x):
-        # NaN fails "> 0" too, but "finite" is then the useful word.
-        raise param_error(param, owner, "finite" if requirement == "finite" else f"finite and {requirement}", x)
-    if not _TESTS[requirement](x):
-        raise param_error(param, owner, requirement, x)
-    return x
 
 
 class GaussianSteps:
@@ -92,7 +61,7 @@ class GaussianSteps:
     example_params: ClassVar[dict[str, Any]] = {"sigma_theta": 1e-6}
 
     def __init__(self, sigma_theta: float) -> None:
-        self.sigma_theta = _real(sigma_theta, "sigma_theta", "gaussian_steps", "> 0")
+        self.sigma_theta = check_scalar(sigma_theta, "sigma_theta", "gaussian_steps", "> 0")
 
     def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:
         """theta at t = 0 ... steps (in tau_th), shape ``(steps + 1,)``."""
@@ -151,9 +120,9 @@ class OrnsteinUhlenbeck:
     example_params: ClassVar[dict[str, Any]] = {"sigma_theta": 1e-6, "tau_c": 2.0}
 
     def __init__(self, sigma_theta: float, tau_c: float, theta0: float = 0.0) -> None:
-        self.sigma_theta = _real(sigma_theta, "sigma_theta", "ornstein_uhlenbeck", "> 0")
-        self.tau_c = _real(tau_c, "tau_c", "ornstein_uhlenbeck", "> 0")
-        self.theta0 = _real(theta0, "theta0", "ornstein_uhlenbeck")
+        self.sigma_theta = check_scalar(sigma_theta, "sigma_theta", "ornstein_uhlenbeck", "> 0")
+        self.tau_c = check_scalar(tau_c, "tau_c", "ornstein_uhlenbeck", "> 0")
+        self.theta0 = check_scalar(theta0, "theta0", "ornstein_uhlenbeck")
 
     @property
     def phi(self) -> float:
@@ -216,11 +185,11 @@ class Sinusoidal:
 
     def __init__(self, amplitude: float, period: float, phase: float = 0.0, noise_std: float = 0.0,
                  theta0: float = 0.0) -> None:
-        self.amplitude = _real(amplitude, "amplitude", "sinusoidal", ">= 0")
-        self.period = _real(period, "period", "sinusoidal", "> 0")
-        self.phase = _real(phase, "phase", "sinusoidal")
-        self.noise_std = _real(noise_std, "noise_std", "sinusoidal", ">= 0")
-        self.theta0 = _real(theta0, "theta0", "sinusoidal")
+        self.amplitude = check_scalar(amplitude, "amplitude", "sinusoidal", ">= 0")
+        self.period = check_scalar(period, "period", "sinusoidal", "> 0")
+        self.phase = check_scalar(phase, "phase", "sinusoidal")
+        self.noise_std = check_scalar(noise_std, "noise_std", "sinusoidal", ">= 0")
+        self.theta0 = check_scalar(theta0, "theta0", "sinusoidal")
         if self.amplitude == 0 and self.noise_std == 0:
             # theta would be constant: nothing would ever rearrange.
             raise param_error("amplitude", "sinusoidal", "> 0 when noise_std = 0", self.amplitude)
@@ -285,9 +254,9 @@ class Ramp:
     example_params: ClassVar[dict[str, Any]] = {"rate": 1e-7, "period": 20.0}
 
     def __init__(self, rate: float, theta0: float = 0.0, period: float | None = None) -> None:
-        self.rate = _real(rate, "rate", "ramp", "!= 0")
-        self.theta0 = _real(theta0, "theta0", "ramp")
-        self.period = None if period is None else _real(period, "period", "ramp", "> 0")
+        self.rate = check_scalar(rate, "rate", "ramp", "!= 0")
+        self.theta0 = check_scalar(theta0, "theta0", "ramp")
+        self.period = None if period is None else check_scalar(period, "period", "ramp", "> 0")
 
     def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:
         """theta at t = 0 ... steps (in tau_th), shape ``(steps + 1,)``; ``rng`` is unused."""
@@ -412,9 +381,9 @@ class Series:
             raise param_error("path", "series", "a non-empty path", path)
         if not (isinstance(delimiter, str) and len(delimiter) == 1 and delimiter not in "\r\n\"#"):
             raise param_error("delimiter", "series", "one character (not a quote, '#' or a newline)", delimiter)
-        self.kappa = _real(kappa, "kappa", "series", "!= 0")
-        self.T0 = _real(T0, "T0", "series")
-        self.tau_th = _real(tau_th, "tau_th", "series", "> 0")
+        self.kappa = check_scalar(kappa, "kappa", "series", "!= 0")
+        self.T0 = check_scalar(T0, "T0", "series")
+        self.tau_th = check_scalar(tau_th, "tau_th", "series", "> 0")
         self.path = Path(path)
         self.delimiter = delimiter
         self.time, self.temperature = _read_series(self.path, delimiter, "series")
@@ -422,7 +391,7 @@ class Series:
         if t0 is None:
             self.t0 = first
         else:
-            self.t0 = _real(t0, "t0", "series")
+            self.t0 = check_scalar(t0, "t0", "series")
             if not first <= self.t0 <= last:
                 raise param_error("t0", "series", f"within the series' times [{first!r}, {last!r}]", self.t0)
         # The relative slack lets a grid that ends on the last sample count, whatever the rounding
