@@ -152,6 +152,7 @@ class Streams:
     --------
     >>> from slidernet.config import load_config
     >>> scene = Scene.from_config(load_config({"network": {"Ntilde": 1e-7}, "steps": 3,
+    ...     "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
     ...     "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}}))
     >>> streams = Streams(scene, np.random.SeedSequence(1))
     >>> thetas, mu = streams.start()
