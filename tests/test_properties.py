@@ -106,7 +106,7 @@ def slip_by_slip(real: Realization):
     while True:
         if not queue:
             queue = list(real.draws["thresholds"].take(real.scene.batch))
-        real.buffers = real.buffers._replace(mu=np.array(queue[:1]))
+        real.streams.buffers = real.buffers._replace(mu=np.array(queue[:1]))  # the buffers' owner
         st["mu_pos"] = 0
         before = (real.thresholds, float(st["u"]), float(st["x_G"]), int(st["n_events"]))
         status = real.backend.run(real, real.thetas)
