@@ -5,7 +5,7 @@ Build (from the repository root, after ``pip install -e ".[docs]"``)::
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
 Generated parts: the configuration reference from the pydantic models of
-``slidernet/config.py`` (autodoc-pydantic), the API reference from the
+``slidernet.config`` (autodoc-pydantic), the API reference from the
 docstrings (autodoc, autosummary, numpydoc), the gallery from ``examples/``
 (sphinx-gallery, which runs every example). The gallery runs each example's
 ``--quick`` preset unless ``SLIDERNET_DOCS_QUICK=0`` is set (see

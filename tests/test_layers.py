@@ -73,11 +73,11 @@ def test_every_stage_is_ranked():
     assert stages <= set(RANK), stages - set(RANK)
 
 
-# The values of ``solver.kernel``. The configuration checks and picks them (config.py: the key's checks and
-# choose_kernel, the one rule), the scene checks an explicit choice against its network, and
+# The values of ``solver.kernel``. The configuration checks and picks them (config/run.py: the key's checks;
+# config/rules.py: choose_kernel, the one rule), the scene checks an explicit choice against its network, and
 # solver/backends.py maps the choice to a backend (BACKENDS); no other module may branch on one.
 KERNEL_NAMES = {"pair", "csr", "vec"}
-ALLOWED = {"config.py", "solver/scene.py", "solver/backends.py"}
+ALLOWED = {"config/run.py", "solver/scene.py", "solver/backends.py"}
 
 
 def _kernel_name_comparisons(path: Path) -> list[int]:

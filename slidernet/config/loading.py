@@ -1,0 +1,149 @@
+"""Loading a configuration: from a TOML file or a dict to a validated :class:`Config` with its plugins built.
+
+Every check happens here, before any work: structure and ranges through
+pydantic, plugin names and parameters by building the plugins, and the
+checks that need them built (an incline steeper than every threshold, a
+driver too short for the run). Pydantic's errors are rewritten as one
+:class:`~slidernet.errors.ConfigError` that names each field and the
+reason.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from slidernet.config.run import Config
+from slidernet.errors import ConfigError
+from slidernet.model.network import Network
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+
+def _describe(err: Mapping[str, Any]) -> str:
+    # Drop pydantic's internal names of union members and validators from the path.
+    loc = ".".join(
+        str(p) for p in err["loc"] if not (str(p).startswith("function-") or "[" in str(p))
+    )
+    kind = err["type"]
+    ctx = err.get("ctx") or {}
+    got = err.get("input")
+    if kind == "missing":
+        return f"The {loc!r} field is required."
+    if kind == "extra_forbidden":
+        parent, _, key = loc.rpartition(".")
+        where = f" in [{parent}]" if parent else ""
+        return f"Unknown key {key!r}{where}."
+    bounds = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",
+              "less_than_equal": "<="}
+    if kind in bounds:
+        limit = next(iter(ctx.values()))
+        return f"The {loc!r} field must be {bounds[kind]} {limit}. Got {got!r} instead."
+    if kind == "finite_number":
+        return f"The {loc!r} field must be a finite number. Got {got!r} instead."
+    if kind == "value_error":
+        msg = str(ctx.get("error", err["msg"]))
+        return f"The {loc!r} field: {msg}." if loc else f"Invalid combination: {msg}."
+    return f"The {loc!r} field: {err['msg']}. Got {got!r} instead."
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """A configuration file as a dict, not validated; relative file paths made relative to the file.
+
+    Files named in a config file (a graph, a temperature series, measured
+    thresholds) are found next to that file.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            source = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+    friction = source.get("friction")
+    static = friction.get("static") if isinstance(friction, dict) else None
+    for table in (source.get("network"), source.get("driver"), static):
+        if isinstance(table, dict) and isinstance(table.get("path"), str):
+            named = Path(table["path"])
+            if not named.is_absolute():
+                table["path"] = str(path.parent / named)
+    return source
+
+
+def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
+    """Validate a configuration and build its plugins.
+
+    Parameters
+    ----------
+    source : Config, mapping, or path
+        A :class:`Config`, a dict with the keys of docs/model.md section 5, or the
+        path of a TOML file with those keys.
+
+    Returns
+    -------
+    Config
+        The validated configuration, with its plugins already built.
+
+    Raises
+    ------
+    ConfigError
+        On any invalid field; the message names the field and the reason.
+    """
+    if isinstance(source, (str, Path)):
+        source = read_toml(source)
+    if isinstance(source, Config):
+        cfg = source
+    else:
+        if not isinstance(source, Mapping):
+            raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
+        try:
+            cfg = Config.model_validate(dict(source))
+        except ValidationError as exc:
+            # dict.fromkeys: a union reports one error per member, often alike.
+            lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
+            raise ConfigError(f"Invalid configuration:\n{lines}") from None
+    cfg.distribution()
+    _check_incline_holds(cfg)
+    driver = cfg.driver_plugin()
+    # An optional hook: a driver that cannot cover the run (a recorded series
+    # too short) says so now, before any work.
+    check = getattr(driver, "check_steps", None)
+    if check is not None:
+        try:
+            check(cfg.steps)
+        except ConfigError as exc:
+            raise ConfigError(f"The 'driver' field: {exc}") from None
+    return cfg
+
+
+def _check_incline_holds(cfg: Config) -> None:
+    """Refuse an incline steeper than every threshold: tan(incline) >= mu_s for every slider.
+
+    Such a network can never rest: every slider is unstable on its own from
+    t = 0 on. The law's upper end is taken after its truncation at mu_d.
+    """
+    incline = cfg.network.incline
+    if not incline:
+        return
+    hi = cfg.distribution().support()[1]
+    slope = math.tan(math.radians(incline))
+    if hi <= slope:
+        raise ConfigError(
+            f"The 'network.incline' field: tan({incline!r} degrees) = {slope!r} is at or above every static "
+            f"threshold (the law {cfg.friction.static.name!r} of 'friction.static' ends at mu_s = {hi!r}), so no "
+            f"slider can rest on it. Use a smaller angle."
+        )
+
+
+def build_network(cfg: Config) -> Network:
+    """The network of the configured scene (its own seed: the geometry is quenched)."""
+    return cfg.network.build()

@@ -1,0 +1,111 @@
+"""The tables that name a plugin, and building the plugins they name.
+
+``[friction.static]`` and ``[driver]`` name a registered plugin and give the
+parameters of its factory (:class:`PluginSpec`); ``[friction]`` pairs the
+first with mu_d (:class:`FrictionConfig`). Building a plugin binds its
+parameters to its factory's signature first, so that a wrong key is refused,
+by name, before any work; :func:`build_distribution` builds the law of mu_s
+and truncates it below mu_d.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.errors import ConfigError
+from slidernet.plugins import registry
+from slidernet.plugins.distributions import TruncatedBelow
+
+
+class PluginSpec(BaseModel):
+    """A registered plugin by ``name``; every other key is a parameter of its factory."""
+
+    model_config = ConfigDict(extra="allow")
+    name: str = Field(description="The name the plugin is registered under (built-in or from an entry point).")
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The factory's keyword arguments."""
+        return dict(self.model_extra or {})
+
+
+class FrictionConfig(_Strict):
+    """Dynamic coefficient mu_d and the distribution of static thresholds mu_s."""
+
+    mu_d: PositiveFloat = Field(description="Dynamic friction coefficient mu_d (dimensionless).")
+    static: PluginSpec = Field(
+        description="The distribution p(mu_s) of the static thresholds: a registered name and its "
+                    "parameters; conditioned on mu_s > mu_d.")
+
+
+def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
+    factory = reg.get(spec.name)
+    params = spec.params
+    try:
+        signature = inspect.signature(factory)
+    except (TypeError, ValueError):  # pragma: no cover - builtins without signature
+        signature = None
+    try:
+        if signature is not None:
+            signature.bind(**params)
+    except TypeError as exc:
+        accepted = signature.parameters
+        names = ", ".join(repr(p) for p in accepted)
+        # Name only the keys at fault: listing every given key put the right ones among the refused.
+        takes_any = any(p.kind is p.VAR_KEYWORD for p in accepted.values())
+        unknown = [] if takes_any else sorted(set(params) - set(accepted))
+        missing = [name for name, p in accepted.items() if p.default is p.empty
+                   and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and name not in params]
+        if unknown:
+            fault = f"does not accept {unknown}" + (f" and needs {missing}" if missing else "")
+        elif missing:
+            fault = f"does not accept the parameters given: it needs {missing}"
+        else:  # pragma: no cover - positional-only parameters and the like
+            fault = f"does not accept these parameters: {exc}"
+        raise ConfigError(
+            f"The '{field}' field: the {reg.kind} {spec.name!r} {fault}. Its parameters are {names}."
+        ) from None
+    try:
+        return factory(**params)
+    except ConfigError as exc:
+        raise ConfigError(f"The '{field}' field: {exc}") from None
+
+
+def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
+    """Build the mu_s plugin and truncate it below mu_d (docs/model.md section 1)."""
+    dist = _build_plugin(registry.distributions, friction.static, "friction.static")
+    check = getattr(dist, "check_mu_d", None)
+    if check is not None:
+        try:
+            check(friction.mu_d)
+        except ConfigError as exc:
+            raise ConfigError(f"The 'friction.static' field: {exc}") from None
+    try:
+        return TruncatedBelow(dist, friction.mu_d, friction.static.name)
+    except ConfigError as exc:
+        raise ConfigError(f"The 'friction.static' field: {exc}") from None
+
+
+def _takes_sigma_theta(name: object) -> bool | None:
+    """Whether the driver called ``name`` takes a ``sigma_theta`` parameter; None if unknown."""
+    if not isinstance(name, str):
+        return None
+    try:
+        factory = registry.drivers.get(name)
+    except ConfigError:
+        return None
+    try:
+        params = inspect.signature(factory).parameters
+    except (TypeError, ValueError):  # pragma: no cover - no introspectable signature
+        return True
+    return "sigma_theta" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def is_finite(x: float) -> bool:
+    """True for a finite float (helper for plugin validation)."""
+    return math.isfinite(x)

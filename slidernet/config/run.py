@@ -1,0 +1,198 @@
+"""The whole configuration of a run: :class:`Config`, and the names of the observables.
+
+:class:`Config` holds the tables and the keys outside any table, checks
+what no single table can (the values [units] gives against those given
+directly, the observables against the kernel the scene will run on, the
+recorded times against the duration), and builds its plugins once.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, ClassVar, Literal
+
+from pydantic import Field, PrivateAttr, model_validator
+
+from slidernet.config.base import _Strict
+from slidernet.config.creep import CreepConfig
+from slidernet.config.execution import ExecutionConfig
+from slidernet.config.network import NetworkConfig
+from slidernet.config.plugins import (
+    FrictionConfig,
+    PluginSpec,
+    _build_plugin,
+    _takes_sigma_theta,
+    build_distribution,
+)
+from slidernet.config.rules import choose_kernel, choose_tilt_at
+from slidernet.config.solver import SolverConfig
+from slidernet.config.units import _UNITS_RTOL, UnitsConfig, _fill_from_units
+from slidernet.model.builders import KIND_DIMS
+from slidernet.plugins import registry
+from slidernet.plugins.distributions import TruncatedBelow
+
+OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "n_records", "events", "creep")
+
+#: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
+NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
+Observable = Literal["n", "mu_max", "x_G", "mu_eff", "n_records", "events", "creep",
+                     "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
+
+
+class Config(_Strict):
+    """A full run: what to simulate, for how long, and what to record.
+
+    ``mu_eff_at`` says when the virtual tilt test of ``mu_eff`` is made:
+    ``"rearrangements"`` before every rearrangement (the appendix; a 1D pair
+    of sliders), ``"records"`` once per realization at every recorded time
+    (the network tilt test, any network), ``"auto"`` the first where it
+    applies and the second otherwise.
+
+    ``units`` (optional, :class:`UnitsConfig`) computes ``network.Ntilde``
+    and ``driver.sigma_theta`` from a material, a slider size and a
+    temperature amplitude, where they are not given.
+    """
+
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep",)
+
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
+                          "(None: fresh OS entropy, stored in the result).")
+    realizations: Annotated[int, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
+    steps: Annotated[int, Field(ge=1)] = Field(
+        description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")
+    record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = Field(
+        "log", description="Recorded times, in tau_th: 'log'-spaced, 'all', or a list of steps; 0 and 'steps' "
+                           "always included.")
+    log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = Field(
+        20, description="Recorded times per decade of t with record = 'log'.")
+    observables: list[Observable] = Field(
+        default_factory=lambda: ["n", "mu_max", "x_G"],
+        description="Variables to record (default ['n', 'mu_max', 'x_G']; docs/model.md section 3); the "
+                    "network kernels always add their own.",
+    )
+    mu_eff_at: Literal["auto", "rearrangements", "records"] = Field(
+        "auto", description="When the virtual tilt test of 'mu_eff' is made (above).")
+    units: UnitsConfig | None = Field(
+        None, description="A physical setup that gives network.Ntilde and driver.sigma_theta where they are "
+                          "not given.")
+    network: NetworkConfig = Field(description="The network of sliders and springs.")
+    friction: FrictionConfig = Field(description="mu_d and the distribution of the static thresholds mu_s.")
+    driver: PluginSpec = Field(
+        description="The temperature driver theta(t): a registered name and its parameters.")
+    solver: SolverConfig = Field(default_factory=SolverConfig, description="Choices of the solver.")
+    execution: ExecutionConfig = Field(
+        default_factory=ExecutionConfig,
+        description="Where the realizations run; never changes a result, and not part of a run's identity.")
+    creep: CreepConfig | None = Field(
+        None, description="Parameters of the observable 'creep' (the reptation velocity and the creep events); "
+                          "None: the defaults. Refused without that observable.")
+
+    _distribution: Any = PrivateAttr(default=None)
+    _driver: Any = PrivateAttr(default=None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _units_fill(cls, data: Any) -> Any:
+        return _fill_from_units(data)
+
+    @model_validator(mode="after")
+    def _units_agree(self) -> Config:
+        if self.units is None:
+            return self
+        found = self.units.resolve()
+        if not math.isclose(self.network.Ntilde, found.Ntilde, rel_tol=_UNITS_RTOL):
+            raise ValueError(
+                f"'network.Ntilde' = {self.network.Ntilde!r} disagrees with [units], which gives "
+                f"Ntilde = rho g l0 / Y = {found.Ntilde!r}; give one of them, or the same value"
+            )
+        if found.sigma_theta is None:
+            return self
+        given = self.driver.params.get("sigma_theta")
+        if given is None:
+            if _takes_sigma_theta(self.driver.name) is False:
+                raise ValueError(
+                    f"'units.delta_T' gives sigma_theta = {found.sigma_theta!r}, but the driver "
+                    f"{self.driver.name!r} takes no 'sigma_theta' parameter; remove 'delta_T'"
+                )
+            return self  # an unknown driver: load_config names it
+        try:
+            given = float(given)
+        except (TypeError, ValueError):
+            return self  # the driver itself refuses it, naming the parameter
+        if not math.isclose(given, found.sigma_theta, rel_tol=_UNITS_RTOL):
+            raise ValueError(
+                f"'driver.sigma_theta' = {given!r} disagrees with [units], which gives "
+                f"sigma_theta = alpha delta_T = {found.sigma_theta!r}; give one of them, or the same value"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _check_cross_fields(self) -> Config:
+        if isinstance(self.record, list):
+            if any(t > self.steps for t in self.record):
+                raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
+        size = self.network.size()
+        if self.mu_eff_at == "rearrangements":  # the network is built only for this check, where it may be a pair
+            choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies())
+        if self.solver.kernel == "pair" and size not in (2, None):
+            raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
+        for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue")):
+            if self.solver.kernel == "pair" and name in self.observables:
+                raise ValueError(f"the {name!r} observable ({what}) needs a network kernel; "
+                                 "use 'solver.kernel = \"auto\"' or '\"csr\"'")
+        if self.creep is not None and "creep" not in self.observables:
+            raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
+                             "add \"creep\" to 'observables' or remove the table")
+        if "creep" in self.observables and self.creep_settings().transient >= self.steps:
+            raise ValueError(f"the 'creep.transient' value must be < steps = {self.steps} (the run's duration, "
+                             f"in tau_th), so that a reptation velocity is measured after it. "
+                             f"Got {self.creep_settings().transient!r} instead")
+        return self
+
+    @model_validator(mode="after")
+    def _network_observables_can_be_recorded(self) -> Config:
+        asked = [name for name in NETWORK_OBSERVABLES if name in self.observables]
+        if not asked:
+            return self
+        dim, pair = self._network_dim_and_pair()
+        if pair:
+            raise ValueError(
+                f"the observables {asked} are recorded by the network kernels, and this two-slider scene runs on "
+                f"the 'pair' kernel; set 'solver.kernel = \"csr\"' to record them"
+            )
+        if "y_G" in asked and dim == 1:
+            raise ValueError(
+                f"the 'y_G' observable (the centre of mass along y) needs a 2D network; this {self.network.kind} "
+                f"network is 1D (its displacement is x_G)"
+            )
+        return self
+
+    def _network_dim_and_pair(self) -> tuple[int | None, bool]:
+        """(dimension, runs on the pair kernel) of the network, reading a graph file only if there is one."""
+        pair = self.network.pair_network()  # a graph is built here, once
+        dim = pair.dim if pair is not None else KIND_DIMS[self.network.kind]
+        if dim is None:
+            return None, False  # a graph file that cannot be read: building the scene reports it
+        two = pair is not None and pair.is_two_slider()
+        return dim, choose_kernel(self.solver.kernel, two, dim, self.needs_catalogue()) == "pair"
+
+    def needs_catalogue(self) -> bool:
+        """True if the kernel keeps the event catalogue: for the observable 'events', or 'creep' (read from it)."""
+        return "events" in self.observables or "creep" in self.observables
+
+    def creep_settings(self) -> CreepConfig:
+        """The [creep] table, or its defaults where it is not given."""
+        return self.creep if self.creep is not None else CreepConfig()
+
+    def distribution(self) -> TruncatedBelow:
+        """The mu_s distribution, truncated below mu_d (built once, cached)."""
+        if self._distribution is None:
+            self._distribution = build_distribution(self.friction)
+        return self._distribution
+
+    def driver_plugin(self) -> Any:
+        """The temperature driver (built once, cached)."""
+        if self._driver is None:
+            self._driver = _build_plugin(registry.drivers, self.driver, "driver")
+        return self._driver
