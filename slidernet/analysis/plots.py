@@ -718,7 +718,9 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     ResultError
         Before anything is drawn or written: the file is missing or not
         netCDF; the dataset has no ``t``, ``n`` or ``n_mean`` (not a result
-        of ``slidernet run``) or holds several runs (a sweep).
+        of ``slidernet run``) or holds several runs (a sweep: a Dataset with
+        the sweep dimensions, or a DataTree whose points differ in number
+        of nodes).
     ConfigError
         Before anything is drawn or written: ``path`` has a suffix
         matplotlib cannot write.

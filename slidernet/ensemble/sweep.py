@@ -655,12 +655,13 @@ def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list
     (else an empty list).
     """
     results = [r.isel(t=slice(0, t_common.size)) if "t" in r.dims else r for r in results]
-    # _check_layout makes these hold; a mismatch here is a bug, never a NaN in the result.
+    # Only whether a point has a variable may differ (_check_layout sees to the rest): a variable's dims or a
+    # coordinate that differ between points is a bug, never padded.
     names = _union([[str(n) for n in r.data_vars] for r in results])
     for name in names:
-        dims = {r[name].dims for r in results if name in r.data_vars}
-        if len(dims) > 1:
-            raise ConfigError(f"The sweep points give the variable {name!r} with dims {sorted(dims)}; they "
+        found = {r[name].dims for r in results if name in r.data_vars}
+        if len(found) > 1:
+            raise ConfigError(f"The sweep points give the variable {name!r} with dims {sorted(found)}; they "
                               f"cannot be stacked.")
     coords: dict[str, xr.DataArray] = {}
     for i, r in enumerate(results):
@@ -694,7 +695,7 @@ def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list
         ds[name] = ((*dims, *var.dims), data, dict(var.attrs))
     if not split_nodes:
         return ds, []
-    if "sweep_point" not in taken:
+    if "sweep_point" not in taken | set(dims):
         ds.coords["sweep_point"] = (dims, np.arange(len(results), dtype=np.int64).reshape(shape), {
             "long_name": "index of the sweep point in C order; its per-node variables are in the group "
                          "point_<index>", "units": "1"})
