@@ -157,13 +157,19 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    import xarray as xr
+
     from slidernet.ensemble.sweep import parse_grid, sweep
 
-    ds = sweep(args.config, parse_grid(args.sets), progress=_progress(args), out=args.out,
-               resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-               scheduler_timeout=args.scheduler_timeout)
+    result = sweep(args.config, parse_grid(args.sets), progress=_progress(args), out=args.out,
+                   resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
+                   scheduler_timeout=args.scheduler_timeout)
+    # The points differ in number of nodes: the stacked variables are at the tree's root.
+    tree = isinstance(result, xr.DataTree)
+    ds = result.to_dataset() if tree else result
     swept = [name for name in ds.dims if "sweep_key" in ds[name].attrs]
-    print(f"wrote {args.out / 'result.nc'} ({' x '.join(f'{ds.sizes[d]} {d}' for d in swept)} points)")
+    groups = f"; per-node variables in groups point_0 to point_{len(result.children) - 1}" if tree else ""
+    print(f"wrote {args.out / 'result.nc'} ({' x '.join(f'{ds.sizes[d]} {d}' for d in swept)} points{groups})")
     return 0
 
 

@@ -42,10 +42,12 @@ RUNS = {
 }
 
 
-def layout(path) -> dict:
+def layout(path, group: str | None = None) -> dict:
     """What a file stores, read with netCDF4 (no decoding): dimensions, and per variable its dtype on disk,
-    dimensions, fill value, chunking, filters and attributes; the global attributes."""
-    with netCDF4.Dataset(path) as nc:
+    dimensions, fill value, chunking, filters and attributes; the global attributes (of ``group``, a group's
+    name, else of the root group)."""
+    with netCDF4.Dataset(path) as root:
+        nc = root if group is None else root.groups[group]
         out = {"dims": {d: (len(v), v.isunlimited()) for d, v in nc.dimensions.items()},
                "attrs": {k: (type(v).__name__, v) for k, v in nc.__dict__.items()}}
         for name, var in nc.variables.items():
@@ -179,3 +181,36 @@ def test_an_interrupted_piecewise_write_leaves_the_previous_file(tmp_path):
             raise KeyboardInterrupt
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["result.nc"]
+
+
+def test_every_group_of_a_tree_is_stored_as_a_dataset_is(tmp_path):
+    # A sweep over network size writes a DataTree: every group in the one encoding, inherited coordinates once.
+    ds = _dataset()
+    root = ds.drop_vars(["flag", "label"])
+    child = xr.Dataset({"flag": ds["flag"].variable, "label": ds["label"].variable,
+                        "node_slips": (("realization", "node"), np.arange(12, dtype=np.int64).reshape(3, 4)),
+                        "mu_s": (("realization", "node"), np.full((3, 4), np.nan), {"units": "1"})},
+                        attrs={"sweep_point": 1, "config": json.dumps({"seed": 1})})
+    tree = xr.DataTree.from_dict({"/": root, "point_1": child})
+    write_netcdf(tree, tmp_path / "tree.nc")
+    write_netcdf(root, tmp_path / "root.nc")
+    write_netcdf(child.assign_coords(realization=ds["realization"]), tmp_path / "child.nc")
+    assert layout(tmp_path / "tree.nc") == layout(tmp_path / "root.nc")
+    in_group, alone = layout(tmp_path / "tree.nc", "point_1"), layout(tmp_path / "child.nc")
+    assert "realization" not in in_group and in_group["dims"] == {"node": (4, False)}  # inherited, stored once
+    for name in child.data_vars:
+        assert in_group[name] == alone[name], name
+    assert in_group["attrs"] == alone["attrs"]
+    back = read_result(tmp_path / "tree.nc")
+    assert isinstance(back, xr.DataTree)
+    xr.testing.assert_identical(back, tree)
+    assert back["point_1"]["flag"].dtype == bool and back["point_1"]["node_slips"].dtype == np.int64
+    assert isinstance(read_result(tmp_path / "root.nc"), xr.Dataset)  # a file without groups: a Dataset
+
+
+def test_a_group_s_attribute_is_checked_by_its_name(tmp_path):
+    tree = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"seed": "1"}),
+                                  "point_0": xr.Dataset(attrs={"odd": True})})
+    with pytest.raises(TypeError, match="The attribute 'odd' of the group '/point_0' cannot be stored"):
+        write_netcdf(tree, tmp_path / "tree.nc")
+    assert list(tmp_path.iterdir()) == []

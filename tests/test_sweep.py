@@ -218,7 +218,10 @@ def no_work(monkeypatch):
     (BASE, {"steps": [50, 200]}, r"Sweep points 0 \(steps=50\) and 1 \(steps=200\) cannot be stacked: .*times"),
     (BASE, {"realizations": [2, 3]}, "2 and 3 realizations"),
     (BASE, {"observables": [["n"], ["n", "x_G"]]}, "observables"),
-    (BASE, {"solver.kernel": ["auto", "csr"]}, r"their scenes differ \(kernel 'pair'.* kernel 'csr'"),
+    (with_values(BASE, observables=["n", "mu_eff"], network={"kind": "chain", "n": 2, "Ntilde": 1e-7}),
+     {"network.n": [2, 4]},
+     r"'mu_eff' is measured at the rearrangements in point 0 .* at the records in point 1 "
+     r".*mu_eff_at = \"records\""),
     (with_values(BASE, network={"kind": "chain", "n": 3, "Ntilde": 1e-7}), {"observables": [["n", "events"]]},
      "'events' observable"),
     (BASE, {"steps.x": [1, 2]}, r"'steps.x' needs 'steps' to be a table"),
@@ -226,7 +229,7 @@ def no_work(monkeypatch):
      "overlap"),
     (BASE, {"steps": 50}, "must map to a sequence"),
     (BASE, {}, "at least one key"),
-], ids=["invalid-value", "invalid-last-point", "times-differ", "realizations", "observables", "scenes",
+], ids=["invalid-value", "invalid-last-point", "times-differ", "realizations", "observables", "tilt-tests",
         "events", "not-a-table", "overlapping-keys", "not-a-sequence", "empty"])
 def test_refused_before_any_work(no_work, base, grid, match):
     with pytest.raises(ConfigError, match=match):

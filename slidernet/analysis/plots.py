@@ -575,7 +575,7 @@ TIME_PANELS = (
 )
 
 
-def _read(path: Path) -> xr.Dataset:
+def _read(path: Path) -> xr.Dataset | xr.DataTree:
     """A result file read into memory, or a ResultError that names the file and what is wrong."""
     if not path.exists():
         raise ResultError(f"The result file {str(path)!r} does not exist.")
@@ -589,8 +589,14 @@ def _read(path: Path) -> xr.Dataset:
                           f"{getattr(exc, 'strerror', None) or exc}.") from None
 
 
-def _check_result(ds: xr.Dataset, source: str) -> None:
+def _check_result(ds: xr.Dataset | xr.DataTree, source: str) -> None:
     """Refuse a dataset that is not one run of slidernet (no n over (realization, t))."""
+    if isinstance(ds, xr.DataTree):
+        raise ResultError(
+            f"{source} holds a sweep whose points differ in number of nodes (an xarray DataTree: the stacked "
+            "variables at its root, each point's per-node variables in its group point_<i>), not one run. "
+            "Plot one point: its own result, OUT/points/<i>/result.nc of `slidernet sweep --out OUT`."
+        )
     missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
                                         ("n_mean", "n_mean" in ds.data_vars)) if not there]
     if missing:
@@ -712,7 +718,9 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     ResultError
         Before anything is drawn or written: the file is missing or not
         netCDF; the dataset has no ``t``, ``n`` or ``n_mean`` (not a result
-        of ``slidernet run``) or holds several runs (a sweep).
+        of ``slidernet run``) or holds several runs (a sweep: a Dataset with
+        the sweep dimensions, or a DataTree whose points differ in number
+        of nodes).
     ConfigError
         Before anything is drawn or written: ``path`` has a suffix
         matplotlib cannot write.
@@ -734,7 +742,7 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     """
     from slidernet.config import build_network, load_config
 
-    if isinstance(result, xr.Dataset):
+    if isinstance(result, (xr.Dataset, xr.DataTree)):
         ds, source, name = result, "The dataset", None
     else:
         file = Path(result)

@@ -25,8 +25,8 @@ Dimensions
     variable gains the sweep dimensions in front: ``n`` is
     ``(sigma_theta, realization, t)``, ``r_mean`` is ``(sigma_theta,)``.
 Times
-    The points are stacked along one time axis ``t``, never padded (the
-    sweep itself puts no NaN in a result). The combined ``t`` is the
+    The points are stacked along one time axis ``t``, never padded along
+    it. The combined ``t`` is the
     recorded times of the point with the fewest ``steps``, and every other
     point's recorded times must begin with exactly those; its records after
     them are left out of the combined dataset (a point's ``mu_eff`` bins
@@ -38,15 +38,52 @@ Times
     run). Any other difference in the recorded times is refused before any
     work.
 Layout
-    Every point must give the same variables along the same dimensions: the
-    same number of realizations, the same observables, and a scene with the
-    same kernel, dimension and number of nodes. The event catalogue (whose
-    length differs from run to run) cannot be swept. All of this, and the
-    validity of every point's configuration, is checked before any work.
+    Every point must have the same number of realizations and the same
+    observables, and with ``mu_eff`` the same tilt test: the pair kernel's
+    default, the appendix's test before every rearrangement, and the
+    network test at the recorded times are two estimators, so a sweep that
+    mixes them is refused (``mu_eff_at = "records"`` runs the network test
+    in every scene). The event catalogue and the creep observables (whose lengths differ from run
+    to run) cannot be swept. All of this, and the validity of every point's
+    configuration, is checked before any work. The points' scenes may
+    differ: in kernel (the ``pair`` kernel of two sliders beside the
+    network kernels), dimension and number of nodes (a size sweep,
+    ``network.n = 2, 4, 8``, or ``network.kind`` chain against irregular).
+Absent variables
+    A variable that only some points give (those of the network kernels,
+    ``mu_mean``, ``mu_min``, ``avalanche_count``, ``node_slips``, ``mu_s``,
+    beside the pair kernel; ``y_G`` of 2D beside 1D) is stacked all the same,
+    NaN where a point lacks it, as :func:`xarray.concat` fills it: its
+    dtype becomes float64 (an int64 count is exact below 2^53). A variable
+    every point gives keeps its dtype and bits.
+Per-node variables
+    Those along ``node`` (``node_slips``, ``mu_s``). Where every point's
+    network has the same number of nodes they are stacked with the rest,
+    and :func:`sweep` returns an :class:`xarray.Dataset`, exactly as when
+    the points share their scene. Where the numbers of nodes differ it
+    returns an :class:`xarray.DataTree`: its root is the dataset of every
+    other variable, stacked, plus the coordinate ``sweep_point`` (the sweep
+    dimensions: each point's index i in C order), and it has one child
+    group per point, ``point_<i>``, that holds the point's per-node
+    variables, ``(realization, node)`` (none for the pair kernel) and the
+    attributes ``sweep_point`` (i), ``sweep_assignment`` (the point's keys
+    and values, JSON), ``config`` (its resolved configuration) and
+    ``kernel``. A group inherits the root's coordinates (``realization``).
+    ``tree[f"point_{int(tree['sweep_point'].sel({'network.n': 8}))}"]``
+    is the group of the point ``network.n = 8``.
+Attributes
+    As a run's (``config``, the base configuration with its seed resolved,
+    ``slidernet_version``, ``seed``, ``kernel``, ``execution``: the last
+    point's), plus ``sweep`` (the grid) and ``configs`` (every point's resolved configuration, C order). Where
+    the points' kernels differ, ``kernel`` lists the distinct ones, comma
+    separated, and ``kernels`` (JSON) gives each point's, in C order.
 
 With ``out``, point i (its grid position in C order: the last key varies
 fastest) runs in ``out/points/<i>/`` with the runner's checkpoints there, and
-the combined dataset is written atomically to ``out/result.nc``.
+the combined result is written atomically to ``out/result.nc`` (a
+DataTree as netCDF4 groups, every group in the one result encoding;
+:func:`slidernet.io.read_result` reads back a Dataset or a DataTree, what
+was written).
 ``out/sweep.json`` holds the base configuration, the grid and the resolved
 seed, so a killed sweep resumes point by point (``resume=True``): finished
 points are read back, the interrupted one continues from its checkpoints,
@@ -247,11 +284,11 @@ def sweep(
     scheduler: str | None = None,
     overwrite: bool = False,
     scheduler_timeout: float | None = None,
-) -> xr.Dataset:
-    """Run ``config`` at every point of the product ``grid`` and return one dataset.
+) -> xr.Dataset | xr.DataTree:
+    """Run ``config`` at every point of the product ``grid`` and return one result.
 
     See the module docstring for the rules on seeds, dimension names,
-    recorded times and layout.
+    recorded times, layout, absent and per-node variables.
 
     Parameters
     ----------
@@ -286,14 +323,18 @@ def sweep(
 
     Returns
     -------
-    xarray.Dataset
-        The points' variables with the sweep dimensions in front, e.g.
-        ``n`` (sigma_theta, realization, t) and ``r_mean`` (sigma_theta,);
-        attributes ``config`` (the base configuration as JSON, seed
-        resolved), ``sweep`` (the grid as JSON), ``configs`` (JSON list of
-        every point's resolved configuration, in C order),
+    xarray.Dataset or xarray.DataTree
+        A Dataset where every point's network has the same number of
+        nodes: the points' variables with the sweep dimensions in front,
+        e.g. ``n`` (sigma_theta, realization, t) and ``r_mean``
+        (sigma_theta,); attributes ``config`` (the base configuration as
+        JSON, seed resolved), ``sweep`` (the grid as JSON), ``configs``
+        (JSON list of every point's resolved configuration, in C order),
         ``slidernet_version``, ``seed``, ``kernel`` and ``execution`` (the
-        runner's, of the last point).
+        runner's, of the last point). A DataTree where the numbers of
+        nodes differ: that dataset without the per-node variables at its
+        root, with the coordinate ``sweep_point``; point i's per-node
+        variables, (realization, node), in its child ``point_<i>``.
 
     Raises
     ------
@@ -320,6 +361,18 @@ def sweep(
     [1e-07, 1e-06]
     >>> bool((ds["n"].sel(sigma_theta=1e-6) >= ds["n"].sel(sigma_theta=1e-7)).all())
     True
+
+    Chains of 2, 4 and 8 sliders (the first runs on the pair kernel, which
+    records no per-node variable):
+
+    >>> chains = {**base, "network": {"kind": "chain", "n": 2, "Ntilde": 1e-7}}
+    >>> tree = sweep(chains, {"network.n": [2, 4, 8]})
+    >>> tree["n"].dims, list(tree.children)
+    (('network.n', 'realization', 't'), ['point_0', 'point_1', 'point_2'])
+    >>> tree["point_2"]["node_slips"].dims, tree["point_2"].sizes["node"]
+    (('realization', 'node'), 8)
+    >>> bool(tree["mu_min"].sel({"network.n": 2}).isnull().all())
+    True
     """
     grid = _checked_grid(grid)
     base = _base_dict(config)
@@ -339,7 +392,7 @@ def sweep(
     shape = tuple(len(v) for v in grid.values())
     points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
     cfgs = [_point_config(base, assignment, i) for i, assignment in enumerate(points)]
-    t_common = _check_layout(cfgs, points)
+    t_common, n_nodes = _check_layout(cfgs, points)
 
     if folder is not None and not resume:
         with atomic_output(folder / _SWEEP_JSON) as tmp:
@@ -371,22 +424,32 @@ def sweep(
     finally:
         bar.close()
 
-    ds = _combine(results, keys, grid, shape, t_common)
+    split_nodes = len(set(n_nodes)) > 1
+    ds, groups = _combine(results, keys, grid, shape, t_common, split_nodes)
+    kernels = [r.attrs["kernel"] for r in results]
     ds.attrs = {
         "config": json.dumps(base, sort_keys=True),
         "sweep": json.dumps(grid),
         "configs": json.dumps([json.loads(r.attrs["config"]) for r in results]),
         "slidernet_version": __version__,
         "seed": str(seed),
-        "kernel": results[0].attrs["kernel"],
+        "kernel": ", ".join(dict.fromkeys(kernels)),
         "Conventions": "CF-1.8",
         "title": "slidernet sweep result",
     }
+    if len(set(kernels)) > 1:
+        ds.attrs["kernels"] = json.dumps(kernels)
     if "execution" in results[-1].attrs:
         ds.attrs["execution"] = results[-1].attrs["execution"]
+    result: xr.Dataset | xr.DataTree = ds
+    if split_nodes:
+        for i, group in enumerate(groups):
+            group.attrs = {"sweep_point": i, "sweep_assignment": json.dumps(points[i]),
+                           "config": results[i].attrs["config"], "kernel": kernels[i]}
+        result = xr.DataTree.from_dict({"/": ds, **{f"point_{i}": g for i, g in enumerate(groups)}})
     if folder is not None:
-        write_netcdf(ds, folder / "result.nc")
-    return ds
+        write_netcdf(result, folder / "result.nc")
+    return result
 
 
 _SWEEP_JSON = "sweep.json"
@@ -516,8 +579,8 @@ def _point_config(base: Mapping[str, Any], assignment: Mapping[str, Any], i: int
         raise ConfigError(f"Sweep point {i} ({_describe(assignment)}): {exc}") from None
 
 
-def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarray:
-    """Refuse points that cannot be stacked; return the shared recorded times."""
+def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> tuple[np.ndarray, list[int]]:
+    """Refuse points that cannot be stacked; return the shared recorded times and each point's number of nodes."""
     def refuse(i: int, j: int, why: str) -> ConfigError:
         return ConfigError(f"Sweep points {i} ({_describe(points[i])}) and {j} ({_describe(points[j])}) "
                            f"cannot be stacked: {why}")
@@ -525,7 +588,8 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarra
     times = [record_times(c.steps, c.record, c.log_points_per_decade) for c in cfgs]
     shortest = min(range(len(cfgs)), key=lambda i: cfgs[i].steps)
     t_common = times[shortest]
-    scenes: dict[str, tuple[str, int, int]] = {}
+    scenes: dict[str, tuple[str, int, str | None]] = {}
+    layout: list[tuple[str, int, str | None]] = []
     for i, c in enumerate(cfgs):
         for name, what in (("events", "the event catalogue, whose length differs from run to run"),
                            ("creep", "creep events and cycles, whose numbers differ from run to run")):
@@ -541,7 +605,7 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarra
             raise refuse(0, i, f"{cfgs[0].realizations} and {c.realizations} realizations")
         if set(c.observables) != set(cfgs[0].observables):
             raise refuse(0, i, f"observables {sorted(cfgs[0].observables)} and {sorted(c.observables)}")
-        # What decides the variables and their shapes; the scene is built once per distinct one.
+        # What decides the kernel, the nodes and the tilt test; the scene is built once per distinct one.
         what = json.dumps(c.model_dump(mode="json", include={"network", "solver", "observables", "mu_eff_at"}),
                           sort_keys=True)
         if what not in scenes:
@@ -549,13 +613,15 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> np.ndarra
                 scene = Scene.from_config(c)
             except ConfigError as exc:
                 raise ConfigError(f"Sweep point {i} ({_describe(points[i])}): {exc}") from None
-            scenes[what] = (scene.kernel, scene.network.dim, scene.network.n_nodes)
-        first = next(iter(scenes.values()))
-        if scenes[what] != first:
-            (k0, d0, n0), (k1, d1, n1) = first, scenes[what]
-            raise refuse(0, i, f"their scenes differ (kernel {k0!r}, {d0}D, {n0} nodes against kernel "
-                         f"{k1!r}, {d1}D, {n1} nodes), and so do their variables")
-    return t_common
+            scenes[what] = (scene.kernel, scene.network.n_nodes, scene.tilt_at)
+        layout.append(scenes[what])
+        # Two tilt tests are two estimators: one variable mu_eff must hold one of them.
+        if "mu_eff" in c.observables and layout[i][2] != layout[0][2]:
+            raise refuse(0, i, f"'mu_eff' is measured at the {layout[0][2]} in point 0 (mu_eff_at = "
+                         f"{layout[0][2]!r}) and at the {layout[i][2]} in point {i} (mu_eff_at = "
+                         f"{layout[i][2]!r}), two different estimators; set mu_eff_at = \"records\" (the network "
+                         f"tilt test, which every scene runs) in the configuration")
+    return t_common, [n_nodes for _, n_nodes, _ in layout]
 
 
 def _dim_names(keys: list[str], taken: set[str]) -> list[str]:
@@ -575,22 +641,62 @@ def _coordinate(values: list[Any]) -> np.ndarray:
     return np.array([json.dumps(v, sort_keys=True) for v in values], dtype=str)
 
 
+def _union(names: list[list[str]]) -> list[str]:
+    """The names of every list, each once, in the order of first appearance."""
+    return list(dict.fromkeys(n for group in names for n in group))
+
+
 def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list[Any]], shape: tuple[int, ...],
-             t_common: np.ndarray) -> xr.Dataset:
-    """Stack the points' datasets (C order) along the sweep dimensions."""
+             t_common: np.ndarray, split_nodes: bool) -> tuple[xr.Dataset, list[xr.Dataset]]:
+    """Stack the points' datasets (C order) along the sweep dimensions.
+
+    Returns the stacked dataset and, with ``split_nodes``, one dataset per
+    point of its per-node variables, which the stacked one then leaves out
+    (else an empty list).
+    """
     results = [r.isel(t=slice(0, t_common.size)) if "t" in r.dims else r for r in results]
-    first = results[0]
-    for i, r in enumerate(results[1:], start=1):
-        # _check_layout makes this hold; a mismatch here is a bug, never a NaN in the result.
-        same_vars = {n: v.dims for n, v in r.data_vars.items()} == {n: v.dims for n, v in first.data_vars.items()}
-        if not same_vars or not r.coords.equals(first.coords):
-            raise ConfigError(f"Sweep point {i} gave a dataset laid out unlike point 0's; it cannot be stacked.")
-    dims = _dim_names(keys, set(first.variables) | set(first.dims))
+    # Only whether a point has a variable may differ (_check_layout sees to the rest): a variable's dims or a
+    # coordinate that differ between points is a bug, never padded.
+    names = _union([[str(n) for n in r.data_vars] for r in results])
+    for name in names:
+        found = {r[name].dims for r in results if name in r.data_vars}
+        if len(found) > 1:
+            raise ConfigError(f"The sweep points give the variable {name!r} with dims {sorted(found)}; they "
+                              f"cannot be stacked.")
+    coords: dict[str, xr.DataArray] = {}
+    for i, r in enumerate(results):
+        for name, coord in r.coords.items():
+            if name not in coords:
+                coords[str(name)] = coord
+            elif not coord.equals(coords[str(name)]):
+                raise ConfigError(f"Sweep point {i} gave the coordinate {name!r} unlike an earlier point's; it "
+                                  f"cannot be stacked.")
+    per_node = [n for n in names if split_nodes and any(n in r and "node" in r[n].dims for r in results)]
+    taken = set().union(*(set(r.variables) | set(r.dims) for r in results))
+    dims = _dim_names(keys, taken)
     ds = xr.Dataset(coords={dim: (dim, _coordinate(grid[key]), {"long_name": f"swept configuration value {key!r}",
                                                                 "sweep_key": key})
                             for dim, key in zip(dims, keys, strict=True)})
-    ds = ds.assign_coords(first.coords)
-    for name, var in first.data_vars.items():
-        data = np.stack([r[name].values for r in results]).reshape(shape + var.shape)
+    ds = ds.assign_coords(coords)
+    for name in names:
+        if name in per_node:
+            continue
+        have = [r for r in results if name in r.data_vars]
+        var = have[0][name]
+        if len(have) == len(results):
+            data = np.stack([r[name].values for r in results]).reshape(shape + var.shape)
+        else:
+            # As xarray.concat fills a variable some datasets lack: NaN, in a float array.
+            data = np.full(shape + var.shape, np.nan, dtype=np.result_type(var.dtype, np.float64))
+            flat = data.reshape((len(results), *var.shape))
+            for i, r in enumerate(results):
+                if name in r.data_vars:
+                    flat[i] = r[name].values
         ds[name] = ((*dims, *var.dims), data, dict(var.attrs))
-    return ds
+    if not split_nodes:
+        return ds, []
+    if "sweep_point" not in taken | set(dims):
+        ds.coords["sweep_point"] = (dims, np.arange(len(results), dtype=np.int64).reshape(shape), {
+            "long_name": "index of the sweep point in C order; its per-node variables are in the group "
+                         "point_<index>", "units": "1"})
+    return ds, [xr.Dataset({n: r[n].variable for n in per_node if n in r.data_vars}) for r in results]

@@ -5,10 +5,12 @@ then renamed over the target, so an interrupted run never leaves a partial
 ``result.nc``.
 
 Two writers make result files: :func:`write_netcdf` (a dataset in memory,
-through xarray) and :func:`result_writer` (a file written piece by piece
-with netCDF4, for a run streamed to disk chunk by chunk). Both store every
-variable as :func:`stored` and :func:`variable_encoding` say, so a file reads
-back the same whichever wrote it:
+through xarray; or a :class:`xarray.DataTree`, one netCDF4 group per node,
+for a sweep whose points differ in number of nodes) and
+:func:`result_writer` (a file written piece by piece with netCDF4, for a
+run streamed to disk chunk by chunk). Both store every variable, in every
+group, as :func:`stored` and :func:`variable_encoding` say, so a file reads
+back the same whichever wrote it (:func:`read_result`):
 
 - dtypes are kept: float64 as float64, int64 counts as int64 (never narrowed:
   a run passes 2^31 slips), int8 as int8; a bool is stored as int8 with the
@@ -198,17 +200,21 @@ def stored(name: str, dims: Sequence[str], data: Any, attrs: Mapping[str, Any],
     return data, attrs
 
 
-def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (temporary file, then rename), in the results' encoding.
+def write_netcdf(result: xr.Dataset | xr.DataTree, path: str | Path) -> Path:
+    """Write ``result`` to ``path`` atomically (temporary file, then rename), in the results' encoding.
 
     Every variable is stored as :func:`stored` and :func:`variable_encoding`
-    say, whatever encoding ``ds`` carries (a dataset read from a file
+    say, whatever encoding ``result`` carries (a dataset read from a file
     carries that file's): a file written here reads back as one written by
-    :func:`result_writer`.
+    :func:`result_writer`. A :class:`xarray.DataTree` (a sweep whose points
+    differ in number of nodes, :func:`slidernet.ensemble.sweep.sweep`) is
+    written as netCDF4 groups, one per node of the tree, each group in
+    this same encoding; a child's coordinates inherited from its parents
+    are written once, in the parent's group (xarray's rule).
 
     Parameters
     ----------
-    ds : xarray.Dataset
+    result : xarray.Dataset or xarray.DataTree
     path : path
         The file to write; missing folders are made.
 
@@ -217,7 +223,28 @@ def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
     pathlib.Path
         ``path``.
     """
-    check_attrs(ds.attrs, "the dataset")
+    if isinstance(result, xr.DataTree):
+        groups: dict[str, xr.Dataset] = {}
+        encodings: dict[str, dict[str, dict[str, Any]]] = {}
+        unlimited: dict[str, list[str]] = {}
+        for node in result.subtree:
+            owner = "the dataset" if node is result else f"the group {node.path!r}"
+            groups[node.path], encodings[node.path] = _stored_dataset(node.to_dataset(inherit=False), owner)
+            unlimited[node.path] = [d for d in UNLIMITED if d in groups[node.path].dims]
+        tree = xr.DataTree.from_dict(groups)
+        with atomic_output(path) as tmp:
+            tree.to_netcdf(tmp, engine="netcdf4", encoding=encodings, unlimited_dims=unlimited)
+        return Path(path)
+    out, encoding = _stored_dataset(result, "the dataset")
+    with atomic_output(path) as tmp:
+        out.to_netcdf(tmp, engine="netcdf4", encoding=encoding,
+                      unlimited_dims=[d for d in UNLIMITED if d in out.dims])
+    return Path(path)
+
+
+def _stored_dataset(ds: xr.Dataset, owner: str) -> tuple[xr.Dataset, dict[str, dict[str, Any]]]:
+    """``ds`` as it is stored (:func:`stored`) and the encoding of each of its variables."""
+    check_attrs(ds.attrs, owner)
     aux = {name: ds[name].dims for name in ds.coords if name not in ds.dims}
     variables: dict[str, xr.Variable] = {}
     encoding: dict[str, dict[str, Any]] = {}
@@ -227,10 +254,7 @@ def write_netcdf(ds: xr.Dataset, path: str | Path) -> Path:
         encoding[name] = variable_encoding(var.dims, var.shape, variables[name].dtype)
     out = xr.Dataset({n: v for n, v in variables.items() if n not in ds.coords},
                      coords={n: v for n, v in variables.items() if n in ds.coords}, attrs=ds.attrs)
-    with atomic_output(path) as tmp:
-        out.to_netcdf(tmp, engine="netcdf4", encoding=encoding,
-                      unlimited_dims=[d for d in UNLIMITED if d in out.dims])
-    return Path(path)
+    return out, encoding
 
 
 class ResultWriter:
@@ -366,12 +390,39 @@ def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
     return path
 
 
-def read_result(path: str | Path) -> xr.Dataset:
-    """Load a result file fully into memory (the file is closed on return)."""
+def read_result(path: str | Path) -> xr.Dataset | xr.DataTree:
+    """Load a result file fully into memory (the file is closed on return).
+
+    Parameters
+    ----------
+    path : path
+        A result file: of a run, of a sweep, or any file :func:`write_netcdf`
+        or :func:`result_writer` wrote.
+
+    Returns
+    -------
+    xarray.Dataset or xarray.DataTree
+        What was written: a file without groups as a Dataset (every result
+        of a run, a sweep whose points have the same number of nodes); a
+        file with groups as a DataTree, its root the file's root group (a
+        sweep whose points differ in number of nodes: the stacked variables
+        at the root, each point's per-node variables in its group
+        ``point_<i>``; :mod:`slidernet.ensemble.sweep`).
+    """
+    if _has_groups(path):
+        with xr.open_datatree(path, engine="netcdf4") as tree:
+            return tree.load()
     with xr.open_dataset(path, engine="netcdf4") as ds:
         return ds.load()
 
 
-def result_config(ds: xr.Dataset) -> dict:
+def _has_groups(path: str | Path) -> bool:
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r") as nc:
+        return bool(nc.groups)
+
+
+def result_config(ds: xr.Dataset | xr.DataTree) -> dict:
     """The resolved configuration stored in a result's attributes."""
     return json.loads(ds.attrs["config"])
