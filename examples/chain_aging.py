@@ -67,7 +67,7 @@ class Preset:
     realizations : int
         Independent realizations per chain.
     sigma_theta : float
-        Amplitude of the thermal dilation (dimensionless).
+        Standard deviation of the thermal dilation theta (dimensionless).
     """
 
     steps: int

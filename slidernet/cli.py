@@ -107,7 +107,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     u.add_argument("--material", help=f"a preset ({', '.join(sorted(MATERIALS))}); explicit values override it")
     u.add_argument("--size", type=float, required=True, help="slider size l0, m")
-    u.add_argument("--delta-T", dest="delta_T", type=float, help="temperature amplitude (standard deviation), K")
+    u.add_argument("--delta-T", dest="delta_T", type=float, help="standard deviation of the temperature, K")
     u.add_argument("--rho", type=float, help="density, kg/m^3")
     u.add_argument("--Y", type=float, help="Young's modulus, Pa")
     u.add_argument("--alpha", type=float, help="linear thermal expansion coefficient, 1/K")
