@@ -12,6 +12,12 @@ n + 2 thresholds drawn so far: the exact law
 over the data. For every n the mean of the largest of n independent draws,
 the state at t = 0, is marked on the left edge.
 
+One parameter set (Gaussian mu_s of mean 0.6 and std 0.01, mu_d = 0.5,
+Ntilde = 1e-7, sigma_theta = 1e-6; full preset 20 realizations of 1e4
+tau_th, seed 1). It measures mu_max only, not the static friction (no tilt
+test): with these parameters mu_max of the chains of 4 and 8 shows no trend
+with log t (docs/guides/networks.md, "Aging in chains").
+
 Writes ``chain_aging.png`` and ``chain_aging.nc`` into ``--out``::
 
     python examples/chain_aging.py --out chain_out           # about a minute
@@ -61,7 +67,7 @@ class Preset:
     realizations : int
         Independent realizations per chain.
     sigma_theta : float
-        Amplitude of the thermal dilation (dimensionless).
+        Standard deviation of the thermal dilation theta (dimensionless).
     """
 
     steps: int

@@ -11,7 +11,7 @@ each rearrangement then moves a slider a little, preferentially downhill, and
 the centre of mass creeps. Two sweeps measure the creep velocity
 v = d<x_G>/dt (in l0 per tau_th):
 
-* (a) against f_ext at a fixed amplitude sigma_theta;
+* (a) against f_ext at a fixed sigma_theta (the standard deviation of theta);
 * (b) against sigma_theta at a fixed f_ext.
 
 Writes ``creep_velocity.csv`` (columns ``sweep, f_ext, sigma_theta, v, v_sem,
@@ -136,7 +136,7 @@ def make_config(f_ext: float, sigma_theta: float, preset: Preset, seed: int,
     f_ext : float
         Force along +x on every slider, in units of N.
     sigma_theta : float
-        Amplitude of the thermal dilation (dimensionless).
+        Standard deviation of the thermal dilation theta (dimensionless).
     preset : Preset
         Network size, duration and number of realizations.
     seed : int

@@ -9,8 +9,10 @@ so far, whatever p(mu_s). How it grows with time therefore depends on the
 extreme-value class of p(mu_s). One law of each class, all with support
 starting at a = 0.55 > mu_d = 0.5 (so no truncation is needed):
 
-* ``uniform`` on [0.55, 0.65] -- Weibull class (bounded): mu_max saturates at
-  the upper end, E[z] = m / (m + 1);
+* ``uniform`` on [0.55, 0.65] -- Weibull class (the class of laws bounded
+  above, whose limit law is the reversed Weibull; not the ``weibull`` law,
+  which is in the Gumbel class): mu_max saturates at the upper end,
+  E[z] = m / (m + 1);
 * ``exponential``, 0.55 + Exp(0.05) -- Gumbel class: E[z] = H_m ~ ln m;
 * ``pareto``, 0.5 + 0.05 Pareto(alpha = 3) -- Frechet class:
   E[z] ~ Gamma(2/3) m^(1/3) - 1, a power law.
@@ -102,7 +104,7 @@ class Preset:
     realizations : int
         Independent realizations per law.
     sigma_theta : float
-        Amplitude of the thermal dilation (dimensionless).
+        Standard deviation of the thermal dilation theta (dimensionless).
     """
 
     steps: int

@@ -8,8 +8,9 @@ on expansion and pulls the uphill end forward on contraction: the chain
 reptates downhill (Blanc, Pugnaloni & Géminard, Phys. Rev. E 84, 061303,
 2011). Four panels, each from the runs named in its title:
 
-(a) the reptation velocity (x_G per cycle, in units of one slip
-    2 (mu_s - mu_d) Ntilde l0) against tan(incline) for chains of 2, 3, 4 and 8
+(a) the reptation velocity (x_G per cycle, in units of D Ntilde l0 =
+    2 (mu_s - mu_d) Ntilde l0, the length of one slip of an end slider: not a
+    count of slips) against tan(incline) for chains of 2, 3, 4 and 8
     with constant thresholds (``constant``), with the exact orbit of each
     chain (:func:`slidernet.analysis.theory.chain_creep_segments`): a
     staircase for two sliders, straight segments whose slopes change sign
@@ -125,7 +126,7 @@ def make_config(network: dict[str, Any], angle: float, amplitude: float, cycles:
 
 
 def velocity(ds: Any) -> tuple[float, float]:
-    """x_G per cycle over the second half of the run, in slips: the mean over realizations and its s.e.
+    """x_G per cycle over the second half of the run, in units of SLIP: the mean over realizations and its s.e.
 
     The ``creep`` observable's ``v_creep_cycle``, summed slip by slip from the event catalogue over
     the whole cycles after the transient (half the run).
@@ -140,7 +141,7 @@ def _degrees(tan_alpha: float) -> float:
 
 
 def _segments(n: int, **range_and_value: Any) -> list[dict[str, float]]:
-    """The exact orbit's segments: ends in tan(alpha) or in A / Ntilde, velocities in slips per cycle."""
+    """The exact orbit's segments: ends in tan(alpha) or in A / Ntilde, x_G per cycle in units of SLIP."""
     segs = theory.chain_creep_segments(n, NTILDE, MU_S, MU_D, **range_and_value)
     unit = NTILDE if isinstance(range_and_value.get("amplitude"), tuple) else 1.0
     return [{"lo": s.lo / unit, "hi": s.hi / unit, "v_lo": s.dx_lo / SLIP, "v_hi": s.dx_hi / SLIP,
@@ -251,7 +252,7 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     for n, c in zip(("2", "3", "4", "8"), ("C0", "C1", "C2", "C3"), strict=True):
         _plot_segments(ax, a["theory"][n], c, label="exact orbit (chain_creep_segments)" if n == "2" else None)
     ax.set_xlabel(r"$\tan\alpha$ (downhill load per unit normal load)")
-    ax.set_ylabel("x_G per cycle (slips)")
+    ax.set_ylabel(r"$x_G$ per cycle, in units of $D\tilde N l_0$")
     ax.set_title(rf"(a) constant $\mu_s = {MU_S}$, $\mu_d = {MU_D}$, $A = {a['A_over_Ntilde']}\,\tilde N$",
                  fontsize=10)
     ax.legend(fontsize=8)
@@ -269,7 +270,7 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     bx.axvline(b["A_c_any_state_2"], color="0.4", ls=":", lw=1,
                label=r"$(\mu_d - \tan\alpha)\tilde N$ (2 sliders, any state)")
     bx.set_xlabel(r"$A/\tilde N$ (amplitude of $\theta$)")
-    bx.set_ylabel("x_G per cycle (slips)")
+    bx.set_ylabel(r"$x_G$ per cycle, in units of $D\tilde N l_0$")
     bx.set_title(rf"(b) $\tan\alpha = {TAN_B}$", fontsize=10)
     bx.legend(fontsize=7)
     c = data["c"]
@@ -291,7 +292,7 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     d = data["d"]
     dx.errorbar(d["A_over_Ntilde"], d["v"], yerr=d["sem"], fmt="s", ms=4, mfc="none", color="C4", capsize=2)
     dx.set_xlabel(r"$A/\tilde N$")
-    dx.set_ylabel("x_G per cycle (slips)")
+    dx.set_ylabel(r"$x_G$ per cycle, in units of $D\tilde N l_0$")
     dx.set_title(rf"(d) irregular network, {d['nodes']} nodes, Gaussian, $\tan\alpha = {TAN_NET}$", fontsize=10)
     for axis in (ax, bx, dx):
         axis.grid(alpha=0.3)

@@ -6,7 +6,7 @@
                                           a grid of runs, one dataset with the swept dimensions
 ``slidernet plot RESULT.nc [--out PATH] [--show]``
                                           the standard panels of a result (RESULT.png beside it)
-``slidernet paper [--quick] --out DIR``   reproduces the paper's four figures
+``slidernet paper [--quick] --out DIR``   reproduces the paper's four result figures (Figs. 2-5)
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
 ``slidernet plugins``                     lists the registered plugins, where they come from
@@ -73,7 +73,8 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--show", action="store_true",
                     help="show the figure in a window instead of writing it (with --out: both)")
 
-    paper_help = ("reproduce the four figures of Geminard & Bertin (2010); a full run took 72-77 s on 2 cores and "
+    paper_help = ("reproduce the four result figures of Geminard & Bertin (2010), its Figs. 2-5, written as "
+                  "fig1_* to fig4_*; a full run took 72-77 s on 2 cores and "
                   "0.91 GB of memory in all (measured on a 2-core machine, 2026-11-25)")
     pp = sub.add_parser("paper", help=paper_help, description=paper_help[0].upper() + paper_help[1:] + ".")
     pp.add_argument("--out", type=Path, required=True, help="output directory")
@@ -107,7 +108,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     u.add_argument("--material", help=f"a preset ({', '.join(sorted(MATERIALS))}); explicit values override it")
     u.add_argument("--size", type=float, required=True, help="slider size l0, m")
-    u.add_argument("--delta-T", dest="delta_T", type=float, help="temperature amplitude (standard deviation), K")
+    u.add_argument("--delta-T", dest="delta_T", type=float, help="standard deviation of the temperature, K")
     u.add_argument("--rho", type=float, help="density, kg/m^3")
     u.add_argument("--Y", type=float, help="Young's modulus, Pa")
     u.add_argument("--alpha", type=float, help="linear thermal expansion coefficient, 1/K")

@@ -63,7 +63,8 @@ class NetworkConfig(_Strict):
         None, description="Seed of an 'irregular' network's random points (None: 0); the geometry is the "
                           "same for every realization, whatever the run's seed.")
     k: PositiveFloat | None = Field(
-        None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0) (None: 1).")
+        None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0), the paper's spring "
+                          "(None: 1); k / Ntilde in N/l0 (docs/model.md section 2).")
     kappa: Annotated[float, Field(allow_inf_nan=False)] | None = Field(
         None, description="Dilation coefficient of every spring: its rest length is its length at theta = 0 "
                           "times (1 + kappa theta) (None: 1).")

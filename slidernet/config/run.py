@@ -49,8 +49,8 @@ class Config(_Strict):
     applies and the second otherwise.
 
     ``units`` (optional, :class:`UnitsConfig`) computes ``network.Ntilde``
-    and ``driver.sigma_theta`` from a material, a slider size and a
-    temperature amplitude, where they are not given.
+    and ``driver.sigma_theta`` from a material, a slider size and the
+    standard deviation of the temperature, where they are not given.
     """
 
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep",)

@@ -26,8 +26,8 @@ class UnitsConfig(_Strict):
     A preset ``material`` (``steel``, ``glass``, ``granite``, ``pmma``) and/or
     explicit values (they override the preset's): ``rho`` (kg/m^3), ``Y``
     (Pa), ``alpha`` (1/K), ``conductivity`` (W/(m K)), ``heat_capacity``
-    (J/(kg K)); the slider ``size`` l0 (m); the temperature amplitude
-    ``delta_T`` (K, optional); gravity ``g`` (m/s^2, default 9.81). See
+    (J/(kg K)); the slider ``size`` l0 (m); the standard deviation of the
+    temperature ``delta_T`` (K, optional); gravity ``g`` (m/s^2, default 9.81). See
     :mod:`slidernet.model.units` for the formulas (Ntilde = rho g l0 / Y,
     sigma_theta = alpha delta_T).
 
@@ -48,7 +48,8 @@ class UnitsConfig(_Strict):
     heat_capacity: PositiveFloat | None = Field(None, description="Specific heat capacity, in J/(kg K).")
     size: PositiveFloat = Field(description="Size of a slider, l0, in m.")
     delta_T: PositiveFloat | None = Field(
-        None, description="Amplitude of the temperature variations, in K: gives sigma_theta = alpha delta_T.")
+        None, description="Standard deviation of the temperature, in K (not an amplitude): gives "
+                          "sigma_theta = alpha delta_T.")
     g: PositiveFloat = Field(units.G_STANDARD, description="Acceleration of gravity, in m/s^2.")
 
     @field_validator("material")

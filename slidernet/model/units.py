@@ -95,7 +95,7 @@ def sigma_theta(alpha: float, delta_T: float) -> float:
     alpha : float
         Linear thermal expansion coefficient (the paper's kappa), 1/K.
     delta_T : float
-        Standard deviation (amplitude) of the temperature variations, K.
+        Standard deviation of the temperature, K (not an amplitude).
 
     Returns
     -------
@@ -262,7 +262,7 @@ class Dimensionless:
     size : float
         l0, m.
     delta_T : float or None
-        Temperature amplitude, K.
+        Standard deviation of the temperature, K.
     g : float
         Gravity, m/s^2.
     """
@@ -415,7 +415,7 @@ def dimensionless(
     size : float
         Slider size l0, m.
     delta_T : float, optional
-        Standard deviation (amplitude) of the temperature, K. Without it sigma_theta is None.
+        Standard deviation of the temperature, K. Without it sigma_theta is None.
     g : float
         Gravity, m/s^2 (default 9.81).
 

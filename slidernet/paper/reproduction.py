@@ -6,12 +6,16 @@ from 1e-7 to 1e-5; docs/model.md section 1), overlays the closed forms of
 :mod:`slidernet.analysis.theory` and writes, in ``out_dir``:
 
 =========================  ====================================================
-``fig1_aging.png/.nc``     mu_max vs t (paper's Fig. ``aging``)
-``fig2_diffusion.png/.nc`` <x_G^2> / (sigma_theta l0)^2 vs t (Fig. ``diffusion``)
-``fig3_rearrangements``    (a) n vs t, (b) <r> vs sigma_theta (Fig. ``rearrangement``)
-``fig4_mueff.png/.nc``     (mu_eff - mean mu_s) / sigma_mu vs <r> t (Fig. ``mueff``)
+``fig1_aging.png/.nc``     mu_max vs t (the paper's Fig. 2, ``aging``)
+``fig2_diffusion.png/.nc`` <x_G^2> / (sigma_theta l0)^2 vs t (Fig. 3, ``diffusion``)
+``fig3_rearrangements``    (a) n vs t, (b) <r> vs sigma_theta (Fig. 4, ``rearrangement``)
+``fig4_mueff.png/.nc``     (mu_eff - mean mu_s) / sigma_mu vs <r> t (Fig. 5, ``mueff``)
 ``summary.json``           wall time per figure, presets and measured <r>
 =========================  ====================================================
+
+The files are numbered from 1 but the paper's Fig. 1 is a sketch: file
+``figK`` is the paper's Fig. K + 1 (the figures' titles give the paper's
+numbers).
 
 Each netCDF file carries the resolved configurations of its runs in the
 attribute ``configs`` (JSON: run label -> configuration) and the theory
@@ -68,6 +72,7 @@ PAPER = ('J.-C. Géminard & E. Bertin, "Aging of the frictional properties induc
 class Preset:
     """Run lengths and ensemble sizes of one reproduction.
 
+    Field prefixes follow the file numbers (``figK`` is the paper's Fig. K + 1).
     ``fig12_*``: the runs shared by the aging and diffusion figures;
     ``fig3a_*``: n(t) on a linear time grid; ``fig3b_*``: the sweep of <r>
     over sigma_theta; ``fig4_*``: the tilt-test runs (the expensive ones).
@@ -529,7 +534,7 @@ def _plot_fig4(ds: xr.Dataset, sigma_theta: float, path: Path) -> None:
 
 def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = True, *,
               resume: bool = False, overwrite: bool = False, _preset: Preset | None = None) -> dict[str, Path]:
-    """Reproduce the paper's four result figures, with their data, in ``out_dir``.
+    """Reproduce the paper's four result figures (its Figs. 2 to 5), with their data, in ``out_dir``.
 
     Parameters
     ----------

@@ -26,14 +26,18 @@ fixed number of draws (:data:`RAW_CHUNK`) and keeps the accepted ones it has
 not handed out yet, so that the values never depend on ``solver.batch``.
 
 The built-ins (:data:`BUILTINS`, by the name a config uses) and the
-extreme-value class of the maximum of many draws (what mu_max ages like):
+extreme-value class of the maximum of many draws (what mu_max ages like).
+The ``weibull`` law has no upper end, so its maximum is in the Gumbel
+class; the Weibull class is that of laws bounded above (limit law: the
+reversed Weibull):
 
 ===============  =========================================  =========================
 name             law                                        class of the maximum
 ===============  =========================================  =========================
 ``gaussian``     Normal(mean, std)                          Gumbel
-``uniform``      Uniform(low, high)                         Weibull (bounded)
-``weibull``      loc + scale * Weibull(shape)               Gumbel
+``uniform``      Uniform(low, high)                         Weibull (bounded above)
+``constant``     every mu_s equals value                    none (a point mass)
+``weibull``      loc + scale * Weibull(shape)               Gumbel (no upper end)
 ``lognormal``    loc + median * exp(sigma * Normal(0, 1))   Gumbel
 ``exponential``  loc + Exponential(scale)                   Gumbel
 ``pareto``       loc + scale * Pareto(alpha), x >= 1        Frechet
