@@ -1,0 +1,95 @@
+"""The node states at recorded times (analysis.mechanism) and trends in ln t (analysis.trend), on cases worked
+out by hand."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import slidernet
+from slidernet.analysis.mechanism import node_states, node_summary
+from slidernet.analysis.trend import log_trend
+from slidernet.errors import ConfigError
+
+from .conftest import make_config
+
+PAIR = make_config(**{"seed": 4, "realizations": 3, "steps": 300, "record": "log",
+                      "observables": ["n", "mu_max", "x_G"]})
+CHAIN = make_config(**{"seed": 4, "realizations": 3, "steps": 100, "record": "log",
+                       "observables": ["n", "mu_max", "x_G"], "network": {"kind": "chain", "n": 5, "Ntilde": 1e-7},
+                       "driver.sigma_theta": 5e-7})
+
+
+@pytest.mark.parametrize("cfg", [PAIR, CHAIN], ids=["pair", "chain"])
+def test_node_states_are_the_runs_realizations(cfg):
+    ds = slidernet.run(cfg)
+    times = ds["t"].values
+    states = node_states(cfg, times)
+    # The strongest threshold and the slip count are the run's, to the bit: the same realizations.
+    np.testing.assert_array_equal(states["mu_s"].max("node").values, ds["mu_max"].values)
+    np.testing.assert_array_equal(states["n"].values, ds["n"].values)
+    # Every spring at rest at t = 0 (no f_ext): no force; every node stable at every recorded time.
+    assert (states["load_ratio"].sel(t=0).values == 0.0).all()
+    assert (states["load_ratio"].values <= 1.0 + 1e-9).all()
+
+
+def test_two_sliders_feel_one_spring():
+    # One spring: |F_1| = |F_2|, so load_ratio_1 mu_1 = load_ratio_2 mu_2 at every time.
+    states = node_states(PAIR, [0, 1, 10, 100, 300])
+    force = states["load_ratio"] * states["mu_s"]
+    np.testing.assert_allclose(force.isel(node=0), force.isel(node=1), rtol=1e-12, atol=0)
+
+
+def test_node_summary_uses_realizations_as_the_samples():
+    states = node_states(CHAIN, [0, 100])
+    out = node_summary(states, law_mean=0.6)
+    per_r = states["mu_s"].mean("node")
+    np.testing.assert_allclose(out["mu_s_mean"], per_r.mean("realization"))
+    np.testing.assert_allclose(out["mu_s_sem"], per_r.std("realization", ddof=1) / np.sqrt(3))
+    np.testing.assert_allclose(out["mu_s_shift_mean"], out["mu_s_mean"] - 0.6)
+    assert out["mu_s_quantile"].dims == ("quantile", "t")
+
+
+@pytest.mark.parametrize("times", [[5, 3], [0, 101], [0.5, 2]], ids=["decreasing", "past-the-end", "fractional"])
+def test_bad_times_are_refused(times):
+    with pytest.raises(ConfigError, match=r"'times' parameter of node_states must be increasing whole"):
+        node_states(CHAIN, times)
+
+
+def test_a_config_without_a_seed_is_refused():
+    with pytest.raises(ConfigError, match=r"needs a config with a 'seed'"):
+        node_states({**CHAIN, "seed": None}, [0])
+
+
+def test_log_trend_is_the_mean_of_per_realization_slopes():
+    # The least-squares slope is linear in the data: on a common time grid the mean of the
+    # per-realization slopes is the slope of the mean, and its error the spread of the slopes.
+    rng = np.random.default_rng(3)
+    t = np.array([0, 1, 2, 5, 10, 20, 50, 100.0])
+    slopes = np.array([0.5, 1.0, 2.0, -1.0])
+    y = slopes[:, None] * np.log(np.maximum(t, 1)) + rng.normal(0, 0.01, (4, t.size))
+    v = xr.DataArray(y, dims=("realization", "t"), coords={"t": t, "realization": np.arange(4)})
+    out = log_trend(v)
+    mean_line = log_trend(v.mean("realization").expand_dims(realization=[0]))
+    np.testing.assert_allclose(float(out["slope_mean"]), float(mean_line["slope"][0]), rtol=1e-12)
+    np.testing.assert_allclose(float(out["slope_sem"]), out["slope"].std(ddof=1) / 2, rtol=1e-12)
+    assert np.abs(out["slope"].values - slopes).max() < 0.05
+    assert out.attrs["t_start"] == 1.0 and out.attrs["t_end"] == 100.0
+
+
+def test_log_trend_of_mu_max_of_two_sliders_rises():
+    # The strongest threshold of two sliders never decreases (it is the max of n + 2 draws): every
+    # realization's slope is >= 0, seed 4, 3 realizations.
+    out = log_trend(slidernet.run(PAIR)["mu_max"])
+    assert (out["slope"].values >= 0).all() and out["realizations"] == 3
+
+
+def test_log_trend_refuses_what_it_cannot_fit():
+    v = xr.DataArray(np.zeros((2, 3)), dims=("realization", "t"), coords={"t": [0, 1, 2]})
+    with pytest.raises(ConfigError, match=r"'t_min' parameter of log_trend must be > 0"):
+        log_trend(v, t_min=0)
+    with pytest.raises(ConfigError, match=r"fewer than two recorded times"):
+        log_trend(v, t_min=2)
+    with pytest.raises(ConfigError, match=r"needs values of dims \(realization, t\)"):
+        log_trend(v.isel(realization=0))
