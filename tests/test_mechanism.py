@@ -93,3 +93,28 @@ def test_log_trend_refuses_what_it_cannot_fit():
         log_trend(v, t_min=2)
     with pytest.raises(ConfigError, match=r"needs values of dims \(realization, t\)"):
         log_trend(v.isel(realization=0))
+
+
+@pytest.mark.parametrize("cfg", [PAIR, CHAIN], ids=["pair-rearrangements", "chain-records"])
+def test_mu_eff_realization_pools_back_to_mu_eff(cfg, tmp_path):
+    # Each realization's own bin means, weighted by their counts, give the pooled mu_eff to rounding;
+    # with one test per recorded time (networks) each is that test's sample.
+    cfg = {**cfg, "observables": ["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization"]}
+    ds = slidernet.run(cfg)
+    plain = slidernet.run({**cfg, "observables": ["n", "mu_max", "x_G", "mu_eff"]})
+    np.testing.assert_array_equal(ds["mu_eff"].values, plain["mu_eff"].values)  # the same tests
+    per = ds["mu_eff_realization"]
+    assert per.dims == ("realization", "t")
+    with slidernet.run(cfg, out=tmp_path) as streamed:  # the streamed file holds the same values
+        np.testing.assert_array_equal(streamed["mu_eff_realization"].values, per.values)
+    if cfg["network"]["kind"] == "chain":
+        assert np.isfinite(per.values).all()
+        np.testing.assert_allclose(per.mean("realization"), ds["mu_eff"], rtol=1e-12)
+    else:
+        assert np.isfinite(per.sel(t=0).values).all()  # one test per realization on the fresh state
+        np.testing.assert_allclose(per.sel(t=0).mean("realization"), ds["mu_eff"].sel(t=0), rtol=1e-12)
+
+
+def test_mu_eff_realization_needs_mu_eff():
+    with pytest.raises(ConfigError, match=r"'mu_eff_realization' observable .* needs the tilt tests"):
+        slidernet.load_config({**PAIR, "observables": ["n", "mu_eff_realization"]})

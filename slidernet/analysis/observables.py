@@ -28,6 +28,8 @@ ATTRS = {
                   "units": "1"},
     "mu_eff": {"long_name": "effective static friction coefficient from the virtual tilt test",
                "units": "1"},
+    "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
+                                        "(NaN: none)", "units": "1"},
 }
 
 
@@ -157,6 +159,13 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     for name in ("n", "mu_max", "x_G", "n_records"):
         if name in observables:
             out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
+    if "mu_eff_realization" in observables:
+        # Each realization's own mean of its tilt tests in the bin: independent across realizations,
+        # so trends and errors of mu_eff can come from the spread of realizations, not of time bins.
+        count = np.stack([r["f_count"] for r in records]).astype(np.float64)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            value = np.stack([r["f_sum"] for r in records]) / np.where(count > 0, count, np.nan)
+        out["mu_eff_realization"] = (("realization", "t"), value, ATTRS["mu_eff_realization"])
     _network_variables(out, records, first_realization)
     if "creep_events" in records[0]:
         _creep_variables(out, records)
