@@ -10,7 +10,7 @@ from slidernet import kernels
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import ConfigError
-from slidernet.kernels.tilt_net import N_POS, P_MU, P_U, tilt_test_network
+from slidernet.kernels.tilt_net import N_LOADS, N_POS, P_MU, P_U, tilt_test_network
 from slidernet.model.builders import triangular
 from slidernet.model.network import Network, chain
 from slidernet.plugins.distributions import Gaussian, TruncatedBelow
@@ -44,7 +44,8 @@ def network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu):
     G = np.array([[-F, 0.0], [F, 0.0]])
     heaps, epoch, pos = _pair_work()
     f = tilt_test_network(G, np.array([mu1, mu2]), ops.f_ext, ops.f_bar, ops.net, _settings(mu_d, 10_000),
-                          ops.pair_rule, np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, heaps, epoch)
+                          ops.pair_rule, np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, heaps, epoch,
+                          np.zeros(N_LOADS))
     return f, int(pos[P_MU]), int(pos[P_U])
 
 
@@ -94,7 +95,7 @@ def test_network_tilt_out_of_draws_asks_for_more_and_rolls_back():
     heaps, epoch, pos = _pair_work()
     pos[P_MU], pos[P_U] = 3, 1
     f = tilt_test_network(np.zeros((2, 2)), np.array([0.6, 0.9]), ops.f_ext, 0.0, ops.net, _settings(0.5, 100),
-                          True, np.full(3, 0.7), np.full(1, 0.5), pos, 100, heaps, epoch)
+                          True, np.full(3, 0.7), np.full(1, 0.5), pos, 100, heaps, epoch, np.zeros(N_LOADS))
     assert f == -1.0
     assert (pos[P_MU], pos[P_U]) == (3, 1)
 

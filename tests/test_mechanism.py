@@ -118,3 +118,32 @@ def test_mu_eff_realization_pools_back_to_mu_eff(cfg, tmp_path):
 def test_mu_eff_realization_needs_mu_eff():
     with pytest.raises(ConfigError, match=r"'mu_eff_realization' observable .* needs the tilt tests"):
         slidernet.load_config({**PAIR, "observables": ["n", "mu_eff_realization"]})
+
+
+def test_tilt_loads_bound_the_sample_and_leave_it_unchanged():
+    # The first slip comes first (onset <= collective motion <= sample), the sample and every other
+    # variable are those of a run without the observable, and for two sliders the first onset is at most
+    # (mu_1 + mu_2) / 2: the two onsets f_1 = mu_1 + F and f_2 = mu_2 - F add up to mu_1 + mu_2.
+    for cfg in (CHAIN, {**PAIR, "mu_eff_at": "records"}):
+        base = {**cfg, "observables": ["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization"]}
+        plain = slidernet.run(base)
+        ds = slidernet.run({**base, "observables": [*base["observables"], "tilt_loads"]})
+        for name in plain.data_vars:
+            np.testing.assert_array_equal(ds[name].values, plain[name].values, err_msg=name)
+        first, moving, sample = ds["tilt_first_slip"], ds["tilt_all_moving"], ds["mu_eff_realization"]
+        assert np.isfinite(first.values).all()
+        assert (first <= moving + 1e-15).where(np.isfinite(moving), True).all()
+        assert (moving <= sample + 1e-15).where(np.isfinite(moving), True).all()
+        assert (first <= sample + 1e-15).all()
+    states = node_states({**PAIR, "mu_eff_at": "records"}, ds["t"].values)
+    half_sum = states["mu_s"].mean("node")
+    assert (ds["tilt_first_slip"] <= half_sum + 1e-12).all()
+
+
+@pytest.mark.parametrize(("changes", "match"), [
+    ({"observables": ["n", "tilt_loads"]}, r"'tilt_loads' observable .* needs the tilt tests"),
+    ({"observables": ["n", "mu_eff", "tilt_loads"]}, r"'tilt_loads' observable is read from the network tilt"),
+], ids=["without-mu_eff", "pair-appendix-test"])
+def test_tilt_loads_refusals(changes, match):
+    with pytest.raises(ConfigError, match=match):
+        slidernet.load_config({**PAIR, **changes})

@@ -28,6 +28,10 @@ ATTRS = {
                   "units": "1"},
     "mu_eff": {"long_name": "effective static friction coefficient from the virtual tilt test",
                "units": "1"},
+    "tilt_first_slip": {"long_name": "load per unit normal load along x, f + f_bar, at the first slip of the "
+                                     "network tilt test at t", "units": "1"},
+    "tilt_all_moving": {"long_name": "load f + f_bar at which an avalanche of the tilt test at t first set every "
+                                     "node in motion at once, above mu_d or not (NaN: none did)", "units": "1"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
                                         "(NaN: none)", "units": "1"},
 }
@@ -166,6 +170,9 @@ def realization_variables(records: list[Record], observables: list[str], first_r
         with np.errstate(invalid="ignore", divide="ignore"):
             value = np.stack([r["f_sum"] for r in records]) / np.where(count > 0, count, np.nan)
         out["mu_eff_realization"] = (("realization", "t"), value, ATTRS["mu_eff_realization"])
+    for name in ("tilt_first_slip", "tilt_all_moving"):
+        if name in records[0]:
+            out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
     _network_variables(out, records, first_realization)
     if "creep_events" in records[0]:
         _creep_variables(out, records)

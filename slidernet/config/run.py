@@ -31,11 +31,13 @@ from slidernet.model.builders import KIND_DIMS
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
-OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "n_records", "events", "creep")
+OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
+               "creep")
 
 #: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
 NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
-Observable = Literal["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "n_records", "events", "creep",
+Observable = Literal["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
+                     "creep",
                      "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
 
 
@@ -141,9 +143,15 @@ class Config(_Strict):
             if self.solver.kernel == "pair" and name in self.observables:
                 raise ValueError(f"the {name!r} observable ({what}) needs a network kernel; "
                                  "use 'solver.kernel = \"auto\"' or '\"csr\"'")
-        if "mu_eff_realization" in self.observables and "mu_eff" not in self.observables:
-            raise ValueError("the 'mu_eff_realization' observable (each realization's own mu_eff) needs the tilt "
-                             "tests of 'mu_eff'; add \"mu_eff\" to 'observables'")
+        for name, what in (("mu_eff_realization", "each realization's own mu_eff"),
+                           ("tilt_loads", "the tilt test's loads at its first slip and collective motion")):
+            if name in self.observables and "mu_eff" not in self.observables:
+                raise ValueError(f"the {name!r} observable ({what}) needs the tilt tests of 'mu_eff'; add "
+                                 "\"mu_eff\" to 'observables'")
+        if "tilt_loads" in self.observables and choose_tilt_at(self.mu_eff_at,
+                                                               self.network.pair_tilt_applies()) != "records":
+            raise ValueError("the 'tilt_loads' observable is read from the network tilt test at the recorded "
+                             "times: set 'mu_eff_at = \"records\"'")
         if self.creep is not None and "creep" not in self.observables:
             raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
                              "add \"creep\" to 'observables' or remove the table")

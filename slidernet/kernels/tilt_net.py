@@ -63,6 +63,12 @@ P_U = 1  # read position in the uniform buffer
 N_SLIPS = 2  # slips made by the test (out)
 N_POS = 3
 
+# Slots of the float array ``loads`` (shape (N_LOADS,)) the test fills, each a load per unit normal load
+# along x, f + f_bar, like the sample; NaN where the event did not happen before the test ended.
+L_FIRST = 0  # at the test's first slip (the first critical f)
+L_MOVING = 1  # when an avalanche first set every node in motion at once, whatever its relation to mu_d
+N_LOADS = 2
+
 # The test's two heaps.
 _UNSTABLE = 0  # unstable nodes keyed by overload
 _CRITICAL = 1  # nodes keyed by minus the tilt f at which they reach their threshold
@@ -123,7 +129,8 @@ def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
 
 
 @kernel_jit()
-def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch):
+def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
+                      loads):
     """Raise a uniform tilt on a copy of a network until it slides as a whole.
 
     Parameters
@@ -157,6 +164,12 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         Two heaps over the N nodes (work array).
     epoch : ndarray of int64, shape (N,)
         Work array: the avalanche in which each node last slipped.
+    loads : ndarray of float64, shape (N_LOADS,)
+        Out: the load f + f_bar at the test's first slip (``L_FIRST``), and
+        when an avalanche first set every node in motion at once, above mu_d
+        or not (``L_MOVING``; NaN if none did: a part slid alone). They
+        tell what the sample rests on: the onset of the first slip, the
+        collective motion, and the rule that only motion above mu_d slides.
 
     Returns
     -------
@@ -170,6 +183,8 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
     p_u = pos[P_U]
     heap_clear(heaps)
     f = 0.0
+    loads[L_FIRST] = math.nan
+    loads[L_MOVING] = math.nan
     for j in range(N):
         _key(j, f, G, mu, normal_load, heaps)
         epoch[j] = -1
@@ -187,6 +202,8 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             if fc > f:
                 f = fc
             i = heaps.node[_CRITICAL, 0]
+            if ep == 0:
+                loads[L_FIRST] = f + f_bar
             ep += 1
             moved = 0
             pending = 0
@@ -223,6 +240,8 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
                 pending += int(now) - int(was)
         if moved + pending == N:
             # Every node is in motion at once.
+            if math.isnan(loads[L_MOVING]):
+                loads[L_MOVING] = f + f_bar
             if f + f_bar > settings.mu_d:
                 pos[P_MU] = p_mu
                 pos[P_U] = p_u

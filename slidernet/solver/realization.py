@@ -97,8 +97,10 @@ class Realization:
             "f_sq": np.zeros(T),
             "f_count": np.zeros(T, np.int64),
         }
+        if scene.tilt_loads:
+            self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
         self._tilted = 0  # recorded times whose network tilt test is done
-        self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray] | None = None
+        self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
         self.state["theta"] = self.thetas[0]
         self.state["u"] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
@@ -224,14 +226,15 @@ class Realization:
         f_ext along x. The state is left as it was; the draws come from the
         realization's tilt stream.
         """
-        from slidernet.kernels.tilt_net import N_POS, N_SLIPS, P_MU, P_U, tilt_test_network
+        from slidernet.kernels.tilt_net import N_LOADS, N_POS, N_SLIPS, P_MU, P_U, tilt_test_network
 
         scene = self.scene
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         if self._tilt_work is None:
-            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N_POS, np.int64))
-        heaps, epoch, pos = self._tilt_work
+            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N_POS, np.int64),
+                               np.zeros(N_LOADS))
+        heaps, epoch, pos, loads = self._tilt_work
         F = self.forces().reshape(N, -1)
         st = self.state
         while True:
@@ -240,7 +243,7 @@ class Realization:
             pos[P_MU], pos[P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
             buffers = self.buffers
             f = tilt_test_network(G, self.mu.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
-                                  buffers.tilt_mu, buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps, epoch)
+                                  buffers.tilt_mu, buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps, epoch, loads)
             status = kernels.tilt_status(f)
             if status == kernels.DONE:
                 st["tilt_mu_pos"], st["tilt_u_pos"] = pos[P_MU], pos[P_U]
@@ -268,6 +271,12 @@ class Realization:
         self.out["f_sum"][k] += f
         self.out["f_sq"][k] += f * f
         self.out["f_count"][k] += 1
+        if self.scene.tilt_loads:
+            from slidernet.kernels.tilt_net import L_FIRST, L_MOVING
+
+            loads = self._tilt_work[3]
+            self.out["tilt_first_slip"][k] = loads[L_FIRST]
+            self.out["tilt_all_moving"][k] = loads[L_MOVING]
 
     def _run_kernel(self, to_step: int, stop: StopCheck | None) -> bool:
         """Run the kernel to ``to_step``; False if ``stop`` asked it to stop first (see :meth:`advance`)."""

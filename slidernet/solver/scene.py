@@ -142,6 +142,7 @@ class Scene:
     recompute_every: int
     slip_mode: int
     catalogue: bool = False  # the kernel keeps the event catalogue (for 'events' or 'creep')
+    tilt_loads: bool = False  # the network tilt tests record their loads at the first slip and collective motion
     max_events: int = 0
     keep_events: bool = True  # the catalogue's rows go into the result (observable 'events')
     creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
@@ -205,6 +206,7 @@ class Scene:
             out_steps=record_times(cfg.steps, cfg.record, cfg.log_points_per_decade),
             kernel=kernel,
             tilt_at=tilt_at,
+            tilt_loads="tilt_loads" in cfg.observables and tilt_at == "records",
             max_avalanche=cfg.solver.max_avalanche,
             batch=cfg.solver.batch,
             recompute_every=cfg.solver.recompute_every,
