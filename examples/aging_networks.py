@@ -41,8 +41,8 @@ irregular networks and not at 256; 256 sliders only to 3e3 tau_th.
 Writes ``aging_networks.json`` (every number, with its parameters and the
 configurations) and ``aging_networks.png`` into ``--out``::
 
-    python examples/aging_networks.py --out aging_out --workers 2   # ~8 minutes on 2 cores
-    python examples/aging_networks.py --out aging_out --quick       # seconds
+    python examples/aging_networks.py --out aging_out --workers 2   # 10 min on 2 shared cores
+    python examples/aging_networks.py --out aging_out --quick       # 10 s
 
 Units: time in tau_th, friction coefficients dimensionless, x_G in l0.
 """
