@@ -36,7 +36,7 @@ def assert_png(path: Path) -> None:
     assert path.read_bytes()[:8] == PNG_MAGIC, path
 
 
-@pytest.mark.parametrize("name", ["creep_irregular", "chain_aging"], ids=str)
+@pytest.mark.parametrize("name", ["creep_irregular", "chain_aging", "aging_networks"], ids=str)
 def test_help_names_the_options(name, capsys):
     module = load_example(name)
     with pytest.raises(SystemExit) as exc:
@@ -122,3 +122,29 @@ def test_incline_creep_quick(tmp_path):
         below = np.asarray(b["A_over_Ntilde"]) < b["A_c"][n]
         assert below.any() and (~below).any()
         assert (v[below] == 0).all() and (v[~below] > 0).all()
+
+
+def test_aging_networks_quick(tmp_path):
+    """The --quick preset (chains of 2 and 4, irregular 16; 4 realizations, seed 1; ~10 s): numbers with errors."""
+    import json
+
+    study = load_example("aging_networks")
+    assert study.main(["--quick", "--out", str(tmp_path)]) == 0
+    assert_png(tmp_path / "aging_networks.png")
+    assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
+    data = json.loads((tmp_path / "aging_networks.json").read_text())
+    preset = study.PRESETS["quick"]
+    assert len(data["points"]) == sum(len(g.sizes) * len(g.stds) for g in preset.groups)
+    for p in data["points"]:
+        assert p["config"]["mu_eff_at"] == "records"
+        for name in ("mu_eff", "mu_max", "x_G2"):
+            tr = p[name]
+            assert tr["realizations"] == preset.realizations
+            assert tr["slope_per_ln_t_sem"] > 0 and math.isfinite(tr["slope_per_ln_t_mean"])
+            assert tr["t_end"] == p["steps"]
+        # The tilt test gives a friction above mu_d, and mu_max stands above it.
+        assert 0.5 < p["mu_eff"]["end_mean"] < p["mu_max"]["end_mean"]
+    (mech,) = data["mechanism"]
+    # At rest at t = 0 no spring is stretched: load ratio 0; thermal cycling loads the nodes.
+    assert mech["load_ratio_t0_mean"] == 0.0
+    assert mech["load_ratio_end_mean"] > 0.1
