@@ -30,7 +30,9 @@ On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
      again.
 
 4. **A part of the network slides on its own** when one avalanche at fixed f
-   exceeds ``av_cap`` slips without having set every node in motion. In a
+   exceeds ``av_cap`` slips without having set every node in motion (counted
+   from the avalanche's start, or from the last damped collective motion of
+   rule 3, where both counts start again). In a
    rigid connected network a subset cannot slide for ever (the springs to the
    rest stretch), so this happens along floppy modes: each row of a
    ``square`` lattice (central springs only) slides along x independently.
@@ -256,6 +258,9 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             ep += 1
             epoch[i] = ep
             moved = 1
+            # Rule 4 counts the slips since every node was last in motion: a long damped collective
+            # motion in a large network is not a part sliding alone.
+            av_slips = 0
             pending = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
         if p_mu + 1 > tilt_mu.size:
             return TILT_NEED_DRAWS
