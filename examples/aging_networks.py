@@ -69,8 +69,10 @@ from slidernet.analysis.trend import log_trend
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import save_figure
 
-HERE = Path(__file__).resolve().parent
-BASE_TOML = HERE / "aging_networks.toml"
+try:
+    BASE_TOML = Path(__file__).resolve().with_name("aging_networks.toml")
+except NameError:  # sphinx-gallery defines no __file__; it runs the script from examples/
+    BASE_TOML = Path("aging_networks.toml").resolve()
 JSON_NAME = "aging_networks.json"
 PNG_NAME = "aging_networks.png"
 LN10 = math.log(10.0)
