@@ -6,7 +6,7 @@ cycling a selection of the fresh law (weak ones replaced, strong ones kept),
 and how close to their thresholds do the nodes stand (prestress)?
 :func:`node_states` follows realizations of a configuration and records,
 at the times asked, every node's threshold mu_s and its load ratio
-|F_i| / (mu_s,i N_i) (1 at the threshold; every stable node has at most 1);
+``|F_i| / (mu_s,i N_i)`` (1 at the threshold; every stable node has at most 1);
 :func:`node_summary` reduces them to statistics whose standard errors come
 from independent realizations: per-realization means, then their mean and
 spread, never the nodes of one realization taken as independent (they are
@@ -49,7 +49,7 @@ def node_states(config: Config | Mapping[str, Any] | str | Path, times: Sequence
     -------
     xarray.Dataset
         ``mu_s`` (realization, t, node): the thresholds; ``load_ratio``
-        (realization, t, node): |F_i| / (mu_s,i N_i), dimensionless;
+        (realization, t, node): ``|F_i| / (mu_s,i N_i)``, dimensionless;
         ``n`` (realization, t): slips so far. Attributes: the resolved
         ``config`` (JSON) and ``seed``.
 
