@@ -28,21 +28,30 @@ seed 0):
   0.01, 0.02, 0.03, 1e4 tau_th, and of 256 sliders, std 0.01, 3e3 tau_th,
   all at sigma_theta / Ntilde = 1;
 * irregular 16 and 64 at sigma_theta / Ntilde = 10, std 0.01, 1e3 tau_th;
+* irregular 1024, std 0.01, sigma_theta / Ntilde = 1, to 300 tau_th, 10
+  recorded times per decade;
+* a replica of the chains of 8 and 16 at std 0.01, sigma_theta / Ntilde = 1,
+  1e4 tau_th, with seed 2 and 64 realizations (independent of the first);
 * mechanism (node_states at t = 0 and at the end): chains of 2, 4, 16,
   irregular networks of 16 and 64.
 
-Cuts of the grid: no irregular network of 1024 or 4096 sliders (at 1024 the
-network tilt test exceeded its avalanche cap of 100 slips per node on the
-second step, so mu_eff cannot be measured there with this estimator; 4096
-is beyond the time budget); std 0.02 and 0.03 not at 256 sliders;
-sigma_theta / Ntilde = 10 only at std 0.01, only to 1e3 tau_th for the
-irregular networks and not at 256; 256 sliders only to 3e3 tau_th.
+Every point also records ``tilt_loads``: the load of the tilt test's first
+slip, and the load at which one of its avalanches first set every slider in
+motion, above mu_d or not, so that the answer does not rest on the tilt
+test's sliding rule alone.
+
+Cuts of the grid: 4096 sliders only in the ``large`` preset (4 realizations,
+to 100 tau_th, 5 recorded times per decade: the tilt test's cost grows
+fastest with size); std 0.02 and 0.03 not at 256 or 1024 sliders; sigma_theta / Ntilde =
+10 only at std 0.01, only to 1e3 tau_th for the irregular networks and not
+at 256 or above; 256 sliders only to 3e3 tau_th, 1024 to 300 tau_th.
 
 Writes ``aging_networks.json`` (every number, with its parameters and the
 configurations) and ``aging_networks.png`` into ``--out``::
 
-    python examples/aging_networks.py --out aging_out --workers 2   # 10 min on 2 shared cores
-    python examples/aging_networks.py --out aging_out --quick       # 10 s
+    python examples/aging_networks.py --out aging_out --workers 2                 # the full preset
+    python examples/aging_networks.py --out aging_out --quick                     # seconds
+    python examples/aging_networks.py --out aging_large --preset large --workers 2  # 4096 sliders
 
 Units: time in tau_th, friction coefficients dimensionless, x_G in l0.
 """
@@ -96,6 +105,14 @@ class Group:
         sigma_theta / Ntilde.
     steps : int
         Duration in tau_th.
+    realizations : int, optional
+        Realizations per point, when not the preset's.
+    per_decade : int
+        Recorded times per decade of t (``log_points_per_decade``): fewer
+        tilt tests for the largest networks, where each costs most.
+    seed : int, optional
+        The ensemble's seed, when not the base configuration's (a replica
+        with independent realizations).
     """
 
     name: str
@@ -104,6 +121,9 @@ class Group:
     stds: tuple[float, ...]
     sigma_ratio: float
     steps: int
+    realizations: int | None = None
+    per_decade: int = 20
+    seed: int | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -124,9 +144,19 @@ PRESETS = {
             Group("irregular", "irregular", (16, 64), (0.01, 0.02, 0.03), 1.0, 10_000),
             Group("irregular_256", "irregular", (256,), (0.01,), 1.0, 3_000),
             Group("irregular_sigma10", "irregular", (16, 64), (0.01,), 10.0, 1_000),
+            Group("irregular_1024", "irregular", (1024,), (0.01,), 1.0, 300, per_decade=10),
+            # An independent replica (seed 2, 64 realizations) of the two chain
+            # points that the first run found positive by about 3 standard errors.
+            Group("chains_replica", "chain", (8, 16), (0.01,), 1.0, 10_000, realizations=64, seed=2),
         ),
         mechanism=(("chain", 2, 10_000), ("chain", 4, 10_000), ("chain", 16, 10_000),
                    ("irregular", 16, 10_000), ("irregular", 64, 10_000)),
+    ),
+    # Beyond the full preset's budget: 4096 sliders, a few realizations, to 100 tau_th.
+    "large": Preset(
+        realizations=4,
+        groups=(Group("irregular_4096", "irregular", (4096,), (0.01,), 1.0, 100, per_decade=5),),
+        mechanism=(),
     ),
     "quick": Preset(
         realizations=4,
@@ -148,9 +178,12 @@ def base_config(realizations: int) -> dict[str, Any]:
 
 def group_config(group: Group, realizations: int) -> dict[str, Any]:
     """The base configuration of one sweep (kind, duration, sigma_theta)."""
-    cfg = base_config(realizations)
+    cfg = base_config(realizations if group.realizations is None else group.realizations)
     ntilde = cfg["network"]["Ntilde"]
     cfg["steps"] = group.steps
+    cfg["log_points_per_decade"] = group.per_decade
+    if group.seed is not None:
+        cfg["seed"] = group.seed
     cfg["network"] = {"kind": group.kind, "n": group.sizes[0], "Ntilde": ntilde}
     if group.kind == "irregular":
         cfg["network"]["seed"] = 0
@@ -193,6 +226,20 @@ def _curve(values: xr.DataArray) -> dict[str, list[float]]:
     return {"t": values["t"].values.tolist(), "mean": mean.tolist(), "sem": sem.tolist(), "count": count.tolist()}
 
 
+def _below(values: xr.DataArray, mu_d: float) -> dict[str, Any]:
+    """Per realization, the fraction of its tilt tests at t >= 1 whose collective motion began below mu_d.
+
+    One fraction per realization, so that the mean's error comes from
+    independent realizations.
+    """
+    v = values.sel(t=values["t"] >= 1).transpose("realization", "t").values
+    tested = np.isfinite(v)
+    frac = np.where(tested.any(axis=1), (tested & (v < mu_d)).sum(axis=1) / np.maximum(tested.sum(axis=1), 1),
+                    np.nan)
+    mean, sem, count = _mean_sem(frac)
+    return {"mean": mean, "sem": sem, "realizations": count}
+
+
 def run_group(group: Group, realizations: int, workers: int | None, out: Path | None, resume: bool,
               log: bool = True) -> list[dict[str, Any]]:
     """Run one sweep and reduce every point to its numbers."""
@@ -214,13 +261,18 @@ def run_group(group: Group, realizations: int, workers: int | None, out: Path | 
             point = {
                 "group": group.name, "kind": group.kind, "n": n, "std": std,
                 "std_over_gap": std / (0.6 - 0.5), "sigma_theta_over_Ntilde": group.sigma_ratio,
-                "steps": group.steps, "realizations": realizations,
+                "steps": group.steps, "realizations": cfg["realizations"], "seed": cfg["seed"],
                 "r_mean": float(one["r_mean"]), "r_sem": float(one["r_sem"]),
                 "mu_eff": _trend(one["mu_eff_realization"]),
                 "mu_max": _trend(one["mu_max"]),
                 "x_G2": _trend(x2),
+                # What mu_eff rests on: the tilt test's first slip, and the load
+                # at which one of its avalanches first set every slider moving.
+                "tilt_first_slip": _trend(one["tilt_first_slip"]),
+                "tilt_all_moving": _trend(one["tilt_all_moving"]),
+                "all_moving_below_mu_d": _below(one["tilt_all_moving"], cfg["friction"]["mu_d"]),
                 "curves": {"mu_eff": _curve(one["mu_eff_realization"]), "mu_max": _curve(one["mu_max"]),
-                           "x_G2": _curve(x2)},
+                           "x_G2": _curve(x2), "tilt_all_moving": _curve(one["tilt_all_moving"])},
                 "config": configs[i * len(group.stds) + j],
                 "kernel": json.loads(ds.attrs["kernels"])[i * len(group.stds) + j]
                 if "kernels" in ds.attrs else ds.attrs["kernel"],
@@ -230,6 +282,7 @@ def run_group(group: Group, realizations: int, workers: int | None, out: Path | 
                 e = point["mu_eff"]
                 print(f"{group.name} n={n} std={std}: mu_eff {e['t0_mean']:.4f} -> {e['end_mean']:.4f} "
                       f"(slope/decade {e['slope_per_decade_mean']:+.5f} +- {e['slope_per_decade_sem']:.5f}), "
+                      f"all moving at {point['tilt_all_moving']['end_mean']:.4f}, "
                       f"r = {point['r_mean']:.1f}/tau_th", flush=True)
     if log:
         print(f"{group.name}: {elapsed:.1f} s", flush=True)
@@ -358,13 +411,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--out", type=Path, default=Path("aging_out"), help="output folder (default aging_out)")
-    parser.add_argument("--quick", action="store_true", help="a small grid, short runs (seconds)")
+    parser.add_argument("--quick", action="store_true", help="a small grid, short runs (seconds); "
+                        "the same as --preset quick")
+    parser.add_argument("--preset", choices=sorted(PRESETS), default="full",
+                        help="full (the study, about 13 min on 2 cores), quick, or large (4096 sliders, "
+                             "beyond the full preset's budget)")
     parser.add_argument("--workers", type=int, default=None, help="worker processes per sweep point")
     parser.add_argument("--resume", action="store_true",
                         help="continue the sweeps of an interrupted run in --out (points already done are kept)")
     args = parser.parse_args(argv)
 
-    preset = PRESETS["quick" if args.quick else "full"]
+    name = "quick" if args.quick else args.preset
+    preset = PRESETS[name]
     start = time.perf_counter()
     base = base_config(preset.realizations)
     points: list[dict[str, Any]] = []
@@ -373,7 +431,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     mech = [mechanism(kind, n, steps, preset.realizations) for kind, n, steps in preset.mechanism]
     data = {
         "question": "does thermal cycling increase mu_eff with time in networks of sliders?",
-        "preset": "quick" if args.quick else "full",
+        "preset": name,
         "estimator": "network tilt test at every recorded time (mu_eff_at = 'records'), same at every size; "
                      "trends: log_trend (per-realization slopes vs ln t, t >= 1; errors from their spread)",
         "parameters": {"mu_d": base["friction"]["mu_d"], "mu_s_mean": base["friction"]["static"]["mean"],

@@ -144,6 +144,15 @@ def test_aging_networks_quick(tmp_path):
             assert tr["t_end"] == p["steps"]
         # The tilt test gives a friction above mu_d, and mu_max stands above it.
         assert 0.5 < p["mu_eff"]["end_mean"] < p["mu_max"]["end_mean"]
+        # Its first slip comes first, the collective motion later, sliding last
+        # (per test, so for the means too); unstressed at t = 0, the three coincide
+        # for every chain (checked per realization in tests/test_mechanism.py).
+        first, moving, eff = p["tilt_first_slip"], p["tilt_all_moving"], p["mu_eff"]
+        assert first["end_mean"] <= moving["end_mean"] <= eff["end_mean"]
+        assert moving["realizations"] == preset.realizations
+        assert 0.0 <= p["all_moving_below_mu_d"]["mean"] <= 1.0
+        if p["kind"] == "chain":
+            assert first["t0_mean"] == moving["t0_mean"] == eff["t0_mean"]
     (mech,) = data["mechanism"]
     # At rest at t = 0 no spring is stretched: load ratio 0; thermal cycling loads the nodes.
     assert mech["load_ratio_t0_mean"] == 0.0
