@@ -373,6 +373,7 @@ def study(steps: int, realizations: int, seed: int = 300, cases: Sequence[tuple[
     """:func:`readings` for every case: a dataset over (case, reading, t), with phi.
 
     phi = (mu_eff - mean mu_s) / sigma_mu, the paper's ordinate.
+    ``mu_eff_realization`` has dims (case, reading, realization, t).
 
     Case k runs with seed ``seed + k``.
     """
