@@ -6,14 +6,26 @@ import math
 
 import numpy as np
 import pytest
+import xarray as xr
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import slidernet
+from slidernet.analysis.trend import log_trend
+from slidernet.config import load_config
+from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import ConfigError
 from slidernet.kernels import Draws, new_state
 from slidernet.kernels.tilt import tilt_test_pair
-from slidernet.validation.tilt_readings import READINGS, readings, tilt_test_incline
+from slidernet.solver import Scene
+from slidernet.validation.tilt_readings import (
+    READINGS,
+    claims,
+    readings,
+    realization_readings,
+    study,
+    tilt_test_incline,
+)
 
 
 def _cfg(mu_d: float = 0.5, std: float = 0.02, steps: int = 300, realizations: int = 3, seed: int = 5) -> dict:
@@ -116,3 +128,76 @@ def test_a_network_other_than_the_pair_is_refused():
     cfg["observables"] = ["n", "mu_max"]
     with pytest.raises(ConfigError, match=r"'network\.kind' parameter of readings must be 'two_slider'"):
         readings(cfg)
+
+
+def test_each_realizations_bin_means_are_its_own_tests():
+    """mu_eff_realization[r] is realization r's own f_sum / f_count: the seeds of slidernet.run, in order."""
+    cfg = _cfg(realizations=3)
+    ds = readings(cfg, ["after"])
+    scene = Scene.from_config(load_config(cfg))
+    for r, seed in enumerate(realization_seeds(cfg["seed"], cfg["realizations"])):
+        own = realization_readings(scene, seed, "after")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            expected = own["f_sum"] / own["f_count"]  # NaN where this realization made no test
+        mine = ds["mu_eff_realization"].sel(reading="after", realization=r).values
+        np.testing.assert_array_equal(mine, expected)
+
+
+def test_claims_per_realization_slopes_are_log_trends():
+    """claims()'s per-realization slopes are log_trend's over 1 <= t <= t_end, times ln 10 (per decade)."""
+    ds = study(300, 3, seed=7, cases=[(0.5, 0.2)], which=["threshold", "incline"], progress=False)
+    cases = claims(ds)["cases"]
+    assert [c["reading"] for c in cases] == ["threshold", "incline"]
+    for c in cases:
+        tr = log_trend(ds["mu_eff_realization"].isel(case=0).sel(reading=c["reading"]), t_min=1.0)
+        per_decade = math.log(10) * tr["slope"].values
+        np.testing.assert_allclose(c["slope_per_decade_realizations"], per_decade, rtol=1e-14)
+        assert c["slope_per_decade_realizations_mean"] == pytest.approx(per_decade.mean(), rel=1e-12)
+        assert c["slope_per_decade_realizations_sem"] == pytest.approx(per_decade.std(ddof=1) / math.sqrt(3),
+                                                                       rel=1e-12)
+        assert c["slope_per_decade_realizations_negative"] == int((per_decade < 0).sum())
+        assert c["slope_realizations"] == 3
+
+
+def _lines(slopes: list[float], gap: int | None = None) -> xr.Dataset:
+    """A dataset shaped as study()'s: one case, one reading, realization r on mu = 0.55 + slopes[r] log10 t.
+
+    ``gap``: a time bin where realization 0 made no test (NaN).
+    """
+    t = np.concatenate([[0.0], np.logspace(0, 5, 51)])
+    x = np.log10(np.maximum(t, 1.0))
+    per = np.array([0.55 + b * x for b in slopes])
+    if gap is not None:
+        per[0, gap] = np.nan
+    pooled = np.nanmean(per, axis=0)
+    dims = ("case", "reading", "t")
+    ds = xr.Dataset({"mu_eff": (dims, pooled[None, None]),
+                     "mu_eff_sem": (dims, np.full((1, 1, t.size), 1e-3)),
+                     "mu_eff_realization": (("case", "reading", "realization", "t"), per[None, None]),
+                     "phi": (dims, (pooled[None, None] - 0.6) / 0.01),
+                     "rt": (dims, t[None, None])},
+                    coords={"case": [0], "reading": ["threshold"], "realization": np.arange(len(slopes)), "t": t,
+                            "mu_d": ("case", [0.5]), "ratio": ("case", [0.1]), "sigma_mu": ("case", [0.01])})
+    return ds
+
+
+def test_claims_on_exact_lines_worked_by_hand():
+    """Three realizations on exact lines of -0.001, +0.002, +0.005 per decade.
+
+    Slopes (-1, 2, 5) e-3: mean 2e-3, std 3e-3, SE 3e-3 / sqrt(3) = sqrt(3) e-3; one negative. The pooled
+    bins lie on the mean line, so the weighted fit of the pooled values is the mean slope too.
+    """
+    c = claims(_lines([-0.001, 0.002, 0.005]))["cases"][0]
+    np.testing.assert_allclose(c["slope_per_decade_realizations"], [-0.001, 0.002, 0.005], rtol=1e-10)
+    assert c["slope_per_decade_realizations_mean"] == pytest.approx(0.002, rel=1e-10)
+    assert c["slope_per_decade_realizations_sem"] == pytest.approx(math.sqrt(3) * 1e-3, rel=1e-10)
+    assert c["slope_per_decade_realizations_negative"] == 1
+    assert c["slope_realizations"] == 3
+    assert c["slope_per_decade_pooled"] == pytest.approx(0.002, rel=1e-10)
+
+
+def test_a_bin_without_test_is_left_out_of_that_realizations_fit():
+    """A NaN bin (no test there) leaves a realization on an exact line with the same slope."""
+    c = claims(_lines([-0.001, 0.002, 0.005], gap=20))["cases"][0]
+    np.testing.assert_allclose(c["slope_per_decade_realizations"], [-0.001, 0.002, 0.005], rtol=1e-10)
+    assert c["slope_realizations"] == 3

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from slidernet.analysis.trend import log_trend
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import TiltTestError, param_error
@@ -57,6 +58,7 @@ from slidernet.solver import Realization, Scene
 READINGS = ("threshold", "after", "incline", "incline_after")
 _AFTER = {"threshold": False, "after": True, "incline": False, "incline_after": True}
 _INCLINE = {"threshold": False, "after": False, "incline": True, "incline_after": True}
+LN10 = math.log(10.0)
 
 @kernel_jit(inline="always")
 def incline_onset(F, mu1, mu2):
@@ -284,8 +286,12 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
         Over (reading, t): ``mu_eff`` (the samples of the bin pooled over
         realizations, as ``slidernet.run``'s), ``mu_eff_sem`` (the standard
         error of the realizations' bin means, the honest spread), ``count``;
-        ``r_mean``, the measured rearrangements per tau_th (the first
-        reading's n at the end over the duration, averaged over realizations).
+        over (reading, realization, t): ``mu_eff_realization``, each
+        realization's own mean of its tests in the bin (NaN where it made
+        none), from which trends get their errors
+        (:func:`slidernet.analysis.trend.log_trend`); ``r_mean``, the measured
+        rearrangements per tau_th (the first reading's n at the end over the
+        duration, averaged over realizations).
 
     Examples
     --------
@@ -310,6 +316,9 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
     mu_eff = np.full((len(which), T), np.nan)
     sem = np.full((len(which), T), np.nan)
     count = np.zeros((len(which), T), np.int64)
+    # Each realization's own bin means: the time bins of one trajectory are correlated, so a trend's
+    # error must come from per-realization values (independent), not from the pooled bins.
+    per_real = np.full((len(which), len(seeds), T), np.nan)
     for w, reading in enumerate(which):
         runs = [realization_readings(scene, s, reading) for s in seeds]
         tot = sum(r["f_sum"] for r in runs)
@@ -317,8 +326,9 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
         with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # bins with fewer than 2 realizations: NaN
             mu_eff[w] = tot / cnt
-            means = np.array([r["f_sum"] / r["f_count"] for r in runs])
+            means = np.array([r["f_sum"] / r["f_count"] for r in runs])  # NaN where a realization had no test
             sem[w] = np.nanstd(means, axis=0, ddof=1) / np.sqrt(np.isfinite(means).sum(axis=0))
+        per_real[w] = means
         count[w] = cnt
         if w == 0:  # the horizontal evolution is the same under every reading
             n_end = np.array([float(r["n"]) for r in runs])
@@ -327,8 +337,11 @@ def readings(config: dict[str, Any], which: Sequence[str] = READINGS) -> xr.Data
         {"mu_eff": (("reading", "t"), mu_eff, {"long_name": "tan(alpha_c), pooled over tests and realizations",
                                                "units": "1"}),
          "mu_eff_sem": (("reading", "t"), sem, {"long_name": "standard error over realizations", "units": "1"}),
-         "count": (("reading", "t"), count, {"long_name": "tilt tests in the bin", "units": "1"})},
-        coords={"reading": list(which), "t": ("t", t, {"units": "tau_th"})},
+         "count": (("reading", "t"), count, {"long_name": "tilt tests in the bin", "units": "1"}),
+         "mu_eff_realization": (("reading", "realization", "t"), per_real,
+                                {"long_name": "tan(alpha_c), mean of one realization's tests in the bin "
+                                              "(NaN: no test)", "units": "1"})},
+        coords={"reading": list(which), "realization": np.arange(len(seeds)), "t": ("t", t, {"units": "tau_th"})},
         attrs={"realizations": model.realizations, "seed": str(model.seed)},
     )
     ds["r_mean"] = ((), float(n_end.mean() / scene.steps), {"long_name": "rearrangements per tau_th",
@@ -360,6 +373,7 @@ def study(steps: int, realizations: int, seed: int = 300, cases: Sequence[tuple[
     """:func:`readings` for every case: a dataset over (case, reading, t), with phi.
 
     phi = (mu_eff - mean mu_s) / sigma_mu, the paper's ordinate.
+    ``mu_eff_realization`` has dims (case, reading, realization, t).
 
     Case k runs with seed ``seed + k``.
     """
@@ -387,7 +401,11 @@ def study(steps: int, realizations: int, seed: int = 300, cases: Sequence[tuple[
 
 
 def _log_slope(t: np.ndarray, y: np.ndarray, e: np.ndarray) -> tuple[float, float]:
-    """Weighted least-squares slope of y against log10 t (per decade) and its standard error."""
+    """Weighted least-squares slope of y against log10 t (per decade) and its standard error.
+
+    The pooled fit of :func:`claims`: its standard error treats the time bins
+    as independent points, which bins of the same trajectories are not.
+    """
     ok = (t >= 1) & np.isfinite(y) & np.isfinite(e) & (e > 0)
     x = np.log10(t[ok])
     w = 1.0 / e[ok] ** 2
@@ -397,16 +415,54 @@ def _log_slope(t: np.ndarray, y: np.ndarray, e: np.ndarray) -> tuple[float, floa
     return float(beta[1]), float(np.sqrt(cov[1, 1]))
 
 
+CLAIMS_NOTES = {
+    "slope_per_decade_realizations": (
+        "per realization r: least-squares slope of its bin means mu_eff_realization against log10 t over "
+        "1 <= t <= t_end (slidernet.analysis.trend.log_trend, times ln 10); _mean and _sem are their mean and "
+        "std(ddof=1)/sqrt(R) over the R realizations fitted; _negative counts slopes < 0. Realizations are "
+        "independent: this is the slope's error."),
+    "slope_per_decade_pooled": (
+        "weighted least-squares slope of the pooled mu_eff against log10 t (weights 1/mu_eff_sem^2). Its _sem "
+        "treats the time bins of the same trajectories as independent and understates the error: not a "
+        "significance."),
+}
+
+
 def claims(ds: xr.Dataset) -> dict[str, Any]:
     """The paper's claims on Fig. 5, measured under each reading.
 
     For every case and reading: mu_eff at t = 1 and at the last time, the
-    relative change in per cent, and the slope of mu_eff against log10 t
-    (per decade, weighted by the standard errors). For every ratio: how well
-    the two mu_d collapse, as the mean of (Delta phi)^2 / (sem_1^2 + sem_2^2)
-    over the common range of <r> t (about 1 for a collapse within the errors).
+    relative change in per cent, and two slopes of mu_eff against log10 t,
+    per decade:
+
+    ``slope_per_decade_realizations_*``
+        One least-squares slope per realization, from its own bin means
+        (``mu_eff_realization``, :func:`slidernet.analysis.trend.log_trend`
+        over 1 <= t <= t_end); their mean, standard error (spread / sqrt(R))
+        and the number of negative slopes. Realizations are independent, so
+        this standard error is the slope's.
+    ``slope_per_decade_pooled``, ``slope_per_decade_pooled_sem``
+        The weighted fit of the pooled ``mu_eff`` (weights from
+        ``mu_eff_sem``). It weighs the late, precise bins most, so it is not
+        the same quantity; its error treats the time bins of one trajectory
+        as independent and understates the uncertainty.
+
+    For every ratio: how well the two mu_d collapse, as the mean of
+    (Delta phi)^2 / (sem_1^2 + sem_2^2) over the common range of <r> t
+    (about 1 for a collapse within the errors).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The output of :func:`study` (dims case, reading, realization, t).
+
+    Returns
+    -------
+    dict
+        ``cases`` (one dict per case and reading), ``collapse`` (one per ratio
+        and reading) and ``notes`` (:data:`CLAIMS_NOTES`, what the slopes are).
     """
-    res: dict[str, Any] = {"cases": [], "collapse": []}
+    res: dict[str, Any] = {"cases": [], "collapse": [], "notes": dict(CLAIMS_NOTES)}
     t = ds["t"].values
     first = int(np.searchsorted(t, 1.0))
     for k in range(ds.sizes["case"]):
@@ -415,13 +471,21 @@ def claims(ds: xr.Dataset) -> dict[str, Any]:
             r = d.sel(reading=reading)
             y, e = r["mu_eff"].values, r["mu_eff_sem"].values
             slope, slope_sem = _log_slope(t, y, e)
+            # log_trend fits against ln t: d/d(log10 t) = ln 10 * d/d(ln t).
+            tr = log_trend(r["mu_eff_realization"], t_min=1.0)
+            per_decade = LN10 * tr["slope"].values
             res["cases"].append({
                 "mu_d": float(d["mu_d"]), "ratio": float(d["ratio"]), "sigma_mu": float(d["sigma_mu"]),
                 "reading": str(reading), "mu_eff_t1": float(y[first]), "mu_eff_t1_sem": float(e[first]),
                 "mu_eff_end": float(y[-1]), "mu_eff_end_sem": float(e[-1]), "t_end": float(t[-1]),
                 "change_percent": float(100 * (y[-1] - y[first]) / y[first]),
                 "change_percent_sem": float(100 * np.hypot(e[-1], e[first]) / y[first]),
-                "slope_per_decade": slope, "slope_per_decade_sem": slope_sem,
+                "slope_per_decade_realizations_mean": LN10 * float(tr["slope_mean"]),
+                "slope_per_decade_realizations_sem": LN10 * float(tr["slope_sem"]),
+                "slope_per_decade_realizations_negative": int(np.sum(per_decade < 0)),
+                "slope_realizations": int(tr["realizations"]),
+                "slope_per_decade_realizations": [float(b) for b in per_decade],
+                "slope_per_decade_pooled": slope, "slope_per_decade_pooled_sem": slope_sem,
                 "phi_end": float(r["phi"].values[-1]),
             })
     for ratio in sorted(set(ds["ratio"].values.tolist())):
