@@ -184,7 +184,39 @@ def measure(n: int, args: argparse.Namespace) -> dict[str, Any]:
     result["max_certified_minus_mu_eff"] = float(np.nanmax(vals["dyn_certified"] - vals["dyn_tilt"]))
     result["dyn_tilt_below_mu_d"] = int(np.sum(vals["dyn_tilt"] <= MU_D))
     result["dyn_all_moving_below_mu_d"] = int(np.sum(vals["dyn_all_moving"] < MU_D))
+    result["compare"] = compare(result)
     return result
+
+
+def compare(res: dict[str, Any]) -> dict[str, Any]:
+    """Paired comparisons on the same realizations, and what the dynamic tilt test's motion did.
+
+    Differences of two estimators, realization by realization: at each recorded time, and averaged over
+    the times t >= 1 within each realization first (the times of one realization are not independent),
+    then mean +- standard error over realizations. Counts over the tests at t >= 1: collective motions
+    (every node moving at once) that stopped before the network slid (all_moving < mu_eff, as f only
+    rises), split by their load against mu_d.
+    """
+    t = np.array(res["t"])
+    late = t >= 1
+    v = {key: np.array(res[key]["values"]) for key in ("qs", "qs_tilt", "dyn_tilt", "dyn_all_moving")}
+    out: dict[str, Any] = {}
+    for a, b in (("dyn_tilt", "qs_tilt"), ("dyn_tilt", "qs"), ("qs_tilt", "qs")):
+        diff = v[a] - v[b]
+        R = diff.shape[0]
+        per_t = {int(time): (float(diff[:, k].mean()), float(diff[:, k].std(ddof=1) / math.sqrt(R)))
+                 for k, time in enumerate(t)}
+        pooled = diff[:, late].mean(axis=1)
+        out[f"{a}-{b}"] = {"per_t": per_t,
+                           "mean_t_ge_1": (float(pooled.mean()), float(pooled.std(ddof=1) / math.sqrt(R)))}
+    mu_eff, moving = v["dyn_tilt"][:, late], v["dyn_all_moving"][:, late]
+    stopped = moving < mu_eff
+    out["tests_t_ge_1"] = int(mu_eff.size)
+    out["collective_stopped_below_mu_d"] = int(np.sum(stopped & (moving < MU_D)))
+    out["collective_stopped_above_mu_d"] = int(np.sum(stopped & (moving >= MU_D)))
+    out["collective_first_in_final_motion"] = int(np.sum(~stopped))
+    out["min_dyn_mu_eff"] = float(np.min(v["dyn_tilt"]))
+    return out
 
 
 def fmt(pair: tuple[float, float], digits: int = 4) -> str:
@@ -218,7 +250,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", default="aging_dynamics.json")
     parser.add_argument("--progress", action="store_true")
+    parser.add_argument("--from-json", metavar="PATH", help="print the tables of a saved run again; no run")
     args = parser.parse_args(argv)
+    if args.from_json:
+        with open(args.from_json) as fh:
+            doc = json.load(fh)
+        for res in doc["results"]:
+            res["compare"] = compare(res)
+        report(doc)
+        return
     start = time.perf_counter()
     results = [measure(n, args) for n in args.sizes]
     wall = time.perf_counter() - start
@@ -228,14 +268,31 @@ def main(argv: list[str] | None = None) -> None:
            "python": platform.python_version(), "slidernet": slidernet.__version__, "results": results}
     with open(args.out, "w") as fh:
         json.dump(doc, fh, indent=1)
-    print(table(results, args.steps))
+    report(doc)
+
+
+def report(doc: dict[str, Any]) -> None:
+    """Print the markdown tables of a run's JSON."""
+    results = doc["results"]
+    print(table(results, doc["parameters"]["steps"]))
+    print()
+    print("| N | (iii) − (ii) | (iii) − (i) | (ii) − (i) | collective motions that stopped, below / above μ_d "
+          "| first collective motion in the final one | min (iii) |")
+    print("|---|---|---|---|---|---|---|")
+    for res in results:
+        c = res["compare"]
+        pairs = " | ".join(fmt(c[key]["mean_t_ge_1"]) for key in ("dyn_tilt-qs_tilt", "dyn_tilt-qs", "qs_tilt-qs"))
+        stopped = f"{c['collective_stopped_below_mu_d']} / {c['collective_stopped_above_mu_d']}"
+        print(f"| {res['n']} | {pairs} | {stopped} "
+              f"| {c['collective_first_in_final_motion']} of {c['tests_t_ge_1']} | {c['min_dyn_mu_eff']:.4f} |")
+    print()
     for res in results:
         print(f"N={res['n']}: slips/tau_th dynamics {res['dynamics_slips_per_tau_th']:.3g}, "
               f"QS {res['qs_slips_per_tau_th']:.3g}; "
               f"max(certified - mu_eff) {res['max_certified_minus_mu_eff']:.2e}; "
               f"dyn mu_eff <= mu_d in {res['dyn_tilt_below_mu_d']} tests; all moving below mu_d in "
               f"{res['dyn_all_moving_below_mu_d']}; seconds {res['seconds']}")
-    print(f"wall {wall:.1f} s")
+    print(f"wall {doc['wall_seconds']:.1f} s, {doc['date']}")
 
 
 if __name__ == "__main__":
