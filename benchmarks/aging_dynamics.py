@@ -31,7 +31,11 @@ least-squares slopes against ln t over 1 <= t <= T
 
 Run from the repository root::
 
-    PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --realizations 16 --steps 100 --out aging_dynamics.json
+    PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --realizations 16 --steps 30 --out aging_dynamics.json
+
+(about 5 min on one core; T = 100 takes about three times longer). ``--rate-check R`` instead
+tests the states of the first R realizations at ten times and a tenth of the ramp rate, the
+effect of the rate on the dynamic tilt test (``--rate-check 4 --sizes 3 4``: about 2 min).
 """
 
 from __future__ import annotations
@@ -188,6 +192,37 @@ def measure(n: int, args: argparse.Namespace) -> dict[str, Any]:
     return result
 
 
+def rate_check(n: int, args: argparse.Namespace) -> dict[str, Any]:
+    """The ramp-rate effect: the dynamics' states of the first R realizations tested at rate x 10 and rate / 10.
+
+    Each state is tested three times from the same redraw stream (spawn key (r, 3, k)); the differences
+    of mu_eff, all_moving and certified against the test at ``rate``, mean +- SE over the tests (the
+    records of a realization are taken as independent here: a rough error) and the largest |difference|.
+    """
+    cfg = config(n, args.steps, args.realizations, args.seed)
+    dyn = Dynamics(Scene.from_config(load_config(cfg)), tau_ratio=args.tau_ratio, max_step=args.max_step)
+    seeds = realization_seeds(args.seed, args.realizations)
+    rates = (10 * args.rate, args.rate, args.rate / 10)
+    rows = []
+    for r in range(args.rate_check):
+        out = dyn.run(seeds[r], states=True)
+        for k in range(out["t"].size):
+            row = []
+            for rate in rates:
+                rng = np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(r, KEY_DYN, k)))
+                res = dyn.tilt_test(out["u"][k], out["mu_s"][k], rng, theta=float(out["theta"][k]), rate=rate)
+                row.append([res["mu_eff"], res["all_moving"], res["certified"]])
+            rows.append(row)
+    a = np.array(rows)  # (tests, rate, load)
+    result: dict[str, Any] = {"n": n, "rates": rates, "tests": len(rows), "values": a.tolist()}
+    for j, load in enumerate(("mu_eff", "all_moving", "certified")):
+        for i, label in ((0, "x10"), (2, "/10")):
+            d = a[:, i, j] - a[:, 1, j]
+            result[f"{load} {label}"] = (float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size)),
+                                         float(np.abs(d).max()))
+    return result
+
+
 def compare(res: dict[str, Any]) -> dict[str, Any]:
     """Paired comparisons on the same realizations, and what the dynamic tilt test's motion did.
 
@@ -251,7 +286,24 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", default="aging_dynamics.json")
     parser.add_argument("--progress", action="store_true")
     parser.add_argument("--from-json", metavar="PATH", help="print the tables of a saved run again; no run")
+    parser.add_argument("--rate-check", type=int, default=0, metavar="R",
+                        help="instead of the study: test the states of R realizations at rate x 10 and / 10")
     args = parser.parse_args(argv)
+    if args.rate_check:
+        start = time.perf_counter()
+        checks = [rate_check(n, args) for n in args.sizes]
+        with open(args.out, "w") as fh:
+            json.dump({"parameters": vars(args), "command": " ".join(sys.argv), "results": checks,
+                       "wall_seconds": time.perf_counter() - start}, fh, indent=1)
+        print("| N | load | rate x 10 − rate | rate / 10 − rate | tests |")
+        print("|---|---|---|---|---|")
+        for c in checks:
+            for load in ("mu_eff", "all_moving", "certified"):
+                up, down = c[f"{load} x10"], c[f"{load} /10"]
+                print(f"| {c['n']} | {load} | {up[0]:+.1e} ± {up[1]:.1e} (max {up[2]:.1e}) "
+                      f"| {down[0]:+.1e} ± {down[1]:.1e} (max {down[2]:.1e}) | {c['tests']} |")
+        print(f"wall {time.perf_counter() - start:.1f} s")
+        return
     if args.from_json:
         with open(args.from_json) as fh:
             doc = json.load(fh)
