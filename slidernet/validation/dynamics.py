@@ -265,8 +265,8 @@ class Dynamics:
         sum_i N_i exceeds B_i for every node i, where B_i bounds |v_i - V|.
         This is a proof, not a rule of thumb: while every node moves forward
         the friction forces are mu_d N_i, so the rigid mode accelerates at
-        sum_i F_i / sum_i N_i - mu_d > 0 (that sum only grows with f, as the
-        springs' and the dilation's forces sum to zero), while each other
+        sum_i F_i / sum_i N_i - mu_d > 0 (that sum only grows with f: the
+        springs' forces sum to zero, f_ext and the dilation's are constant), while each other
         mode k of K phi = lambda M phi (M = diag(N_i)) is a free harmonic
         oscillator (the tilt and friction forces are proportional to N_i and
         drive the rigid mode alone); its velocity amplitude
