@@ -242,3 +242,127 @@ def test_2d_network_is_refused() -> None:
 def test_bad_steps() -> None:
     with pytest.raises(ConfigError, match=r"'steps' parameter of Dynamics\.run must be an integer in \[0, 1\]"):
         Dynamics(scene(1), tau_ratio=1e-3).run(np.random.SeedSequence(0), steps=2)
+
+
+# -- 4. the state at the recorded times, and the dynamic tilt test ---------------------------------------------
+
+CHAIN_4 = {"kind": "chain", "n": 4, "Ntilde": Ntilde}
+SMALL_STEPS = {"name": "gaussian_steps", "sigma_theta": 1e-7}
+
+
+def test_states_add_the_state_and_change_nothing() -> None:
+    """run(states=True) gives the same outputs to the bit, plus u, mu_s, F and theta consistent with them.
+
+    At t = 0 nothing has moved (no f_ext): u = 0, F = 0, theta = 0 and mu_s the initial thresholds. At every
+    record F = -K u / Ntilde + g theta / Ntilde (units: u in l0, F in N) to rounding (1e-12 relative), and
+    mu_max is the largest mu_s.
+    """
+    sc = scene(5, network=CHAIN_4, driver=SMALL_STEPS)
+    dyn = Dynamics(sc, tau_ratio=1e-4)
+    plain = dyn.run(np.random.SeedSequence(0))
+    out = dyn.run(np.random.SeedSequence(0), states=True)
+    for key in ("t", "n", "mu_max", "x_G", "overlapping", "moving_at_end"):
+        assert np.array_equal(out[key], plain[key])
+    for key in plain["slips"]:
+        assert np.array_equal(out["slips"][key], plain["slips"][key])
+    T, N = out["t"].size, 4
+    assert out["u"].shape == out["mu_s"].shape == out["F"].shape == (T, N) and out["theta"].shape == (T,)
+    assert np.array_equal(out["mu_s"][0], Realization(sc, np.random.SeedSequence(0)).mu)
+    assert not out["u"][0].any() and not out["F"][0].any() and out["theta"][0] == 0.0
+    assert np.array_equal(out["mu_s"].max(axis=1), out["mu_max"])
+    K = sc.network.stiffness_matrix().toarray()
+    g = np.asarray(sc.operators.g)
+    expected = (-out["u"] @ K.T + out["theta"][:, None] * g) / Ntilde
+    assert np.abs(out["F"] - expected).max() < 1e-12 * np.abs(out["F"]).max()
+    assert np.allclose(out["x_G"], out["u"].mean(axis=1), rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("net", [{"kind": "two_slider", "Ntilde": Ntilde},
+                                 {"kind": "chain", "n": 3, "Ntilde": Ntilde}, CHAIN_4],
+                         ids=["pair", "chain-3", "chain-4"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_tilt_of_the_fresh_state_is_the_quasi_static_one(net: dict[str, Any], seed: int) -> None:
+    """From u = 0 both tests slide in their first avalanche, which starts at f = min mu_s.
+
+    With no spring force the first node starts at f = min mu_s, found in closed form while everything is
+    at rest (no ramp effect), and its slip sets the others in motion with f > mu_d in both tests (for the
+    pair and these seeds: measured, the quasi-static mu_eff is min mu_s). So mu_eff and the first start
+    are min mu_s in both, to rounding (measured: equal to the bit; tolerance 1e-12). The ramp (1e-5 per
+    tau_dyn) shows only in the loads reached during the motion: every node moves within 2 tau_dyn of the
+    first start (measured: all_moving - min mu_s = 0.9e-5 to 1.9e-5; bound 2e-4), and sliding is proved
+    after one or two checks, 2 pi tau_dyn apart (measured: certified - mu_eff = 6.8e-5 to 8.2e-5; bound 1e-3).
+    """
+    sc = scene(1, network=net, driver=SMALL_STEPS)
+    real = Realization(sc, np.random.SeedSequence(seed))
+    mu_min = real.mu.min()
+    out = Dynamics(sc, tau_ratio=1e-4).tilt_test(np.zeros(real.mu.size), real.mu, np.random.default_rng(seed))
+    assert out["mu_eff"] == pytest.approx(real.tilt_test(), abs=1e-12)
+    assert out["mu_eff"] == pytest.approx(mu_min, abs=1e-12)
+    assert out["first_start"] == pytest.approx(mu_min, abs=1e-12)
+    assert mu_min <= out["all_moving"] < mu_min + 2e-4
+    assert out["mu_eff"] < out["certified"] < out["mu_eff"] + 1e-3
+    assert out["starts"] == real.mu.size
+
+
+@pytest.mark.parametrize("rate", [1e-5, 1e-3], ids=["rate-1e-5", "rate-1e-3"])
+def test_equal_thresholds_slide_at_mu_s(rate: float) -> None:
+    """Four unstressed sliders with mu_s = 0.62: all reach it at f = 0.62, whatever the ramp.
+
+    The start is found in closed form at rest, so mu_eff = 0.62 to rounding (tolerance 1e-12) at either
+    rate; every node then moves at once (the ties at the threshold start at s = 0) and the chain, loaded
+    0.12 above mu_d, slides as a rigid body: no internal mode is excited, so the proof holds at the first
+    check, 2 pi tau_dyn later, and the certified load is 0.62 + 2 pi rate (measured to 1e-15; bound
+    0.62 + 2 pi rate (1 + 1e-9)).
+    """
+    sc = scene(1, network=CHAIN_4, driver=SMALL_STEPS)
+    out = Dynamics(sc, tau_ratio=1e-4).tilt_test(np.zeros(4), np.full(4, 0.62), np.random.default_rng(0),
+                                                 rate=rate)
+    assert out["mu_eff"] == pytest.approx(0.62, abs=1e-12)
+    assert out["first_start"] == pytest.approx(0.62, abs=1e-12)
+    assert out["all_moving"] == pytest.approx(0.62, abs=1e-12)
+    assert 0.62 < out["certified"] <= 0.62 + 2 * np.pi * rate * (1 + 1e-9)
+    assert out["starts"] == 4
+
+
+def test_tilt_of_cycled_states_never_slides_at_or_below_mu_d() -> None:
+    """States of a chain of 4 after 3 steps of cycling (prestressed: the first start comes early).
+
+    Sliding is proved only with the mean load above mu_d, so certified > mu_d always; the loads are
+    ordered first_start <= mu_eff <= certified and first_start <= all_moving <= certified; and a
+    state that is tested twice from the same Generator seed gives the same loads (no hidden RNG).
+    """
+    sc = scene(3, network=CHAIN_4, driver=SMALL_STEPS)
+    dyn = Dynamics(sc, tau_ratio=1e-4)
+    out = dyn.run(np.random.SeedSequence(1), states=True)
+    early = []
+    for k in range(out["t"].size):
+        args = (out["u"][k], out["mu_s"][k], np.random.default_rng(k))
+        res = dyn.tilt_test(*args, theta=float(out["theta"][k]))
+        assert res["certified"] > MU_D
+        assert res["first_start"] <= res["mu_eff"] <= res["certified"]
+        assert res["first_start"] <= res["all_moving"] <= res["certified"]
+        early.append(res["first_start"] < MU_D)
+        again = dyn.tilt_test(out["u"][k], out["mu_s"][k], np.random.default_rng(k), theta=float(out["theta"][k]))
+        assert again == res
+    assert any(early)  # the cycled states are prestressed
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"u": np.zeros(3)}, r"'u' parameter of Dynamics\.tilt_test must be a finite array of shape \(4,\)"),
+        ({"u": np.full(4, np.nan)}, r"'u' parameter .* finite array"),
+        ({"mu_s": np.full(4, 0.5)}, r"'mu_s' parameter of Dynamics\.tilt_test .* every value > mu_d = 0\.5"),
+        ({"rng": np.random.SeedSequence(0)}, r"'rng' parameter of Dynamics\.tilt_test must be a numpy\.random"),
+        ({"rate": 0.0}, r"'rate' parameter of Dynamics\.tilt_test must be a finite number > 0 \(per tau_dyn\)"),
+        ({"rate": float("inf")}, r"'rate' .* Got inf"),
+        ({"theta": float("nan")}, r"'theta' parameter of Dynamics\.tilt_test must be a finite number"),
+    ],
+    ids=["u-shape", "u-nan", "mu-at-mu-d", "rng-seedsequence", "rate-zero", "rate-inf", "theta-nan"],
+)
+def test_tilt_bad_arguments(kwargs: dict[str, Any], match: str) -> None:
+    args = {"u": np.zeros(4), "mu_s": np.full(4, 0.6), "rng": np.random.default_rng(0), **kwargs}
+    dyn = Dynamics(scene(1, network=CHAIN_4, driver=SMALL_STEPS), tau_ratio=1e-4)
+    with pytest.raises(ConfigError, match=match):
+        dyn.tilt_test(args.pop("u"), args.pop("mu_s"), args.pop("rng"), **args)
+
