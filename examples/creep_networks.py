@@ -1,5 +1,5 @@
 """Creep of networks of sliders under a constant tangential force: steady or logarithmic?
-=======================================================================================
+======================================================================================
 
 The paper (Geminard & Bertin 2010) announces a study of 2D irregular networks
 in which "the creep motion induced by a constant tangential force" will be
@@ -16,8 +16,8 @@ Two questions, at every size:
   decade [T/10, T], against the number of sliders N;
 * does the creep slow down with time? :func:`slidernet.analysis.trend.creep_law`
   compares each realization's mean velocity over [T/100, T/10] and [T/10, T]:
-  steady creep (x_G ∝ t) predicts a ratio 1, logarithmic creep (x_G ∝ ln t)
-  about 0.1 (computed from the recorded times used).
+  steady creep (x_G proportional to t) predicts a ratio 1, logarithmic creep
+  (x_G proportional to ln t) about 0.1 (computed from the recorded times used).
 
 Every error is a standard error over the independent realizations.
 
