@@ -111,6 +111,8 @@ def test_bad_parameters_are_refused(kwargs, match):
 def test_bad_values_are_refused():
     with pytest.raises(ConfigError, match=r"creep_law needs values of dims \(realization, t\)"):
         creep_law(xr.DataArray(T, dims=("t",), coords={"t": T}))
+    with pytest.raises(ConfigError, match=r"creep_law needs finite, increasing recorded times t"):
+        creep_law(series([[0, 0, 9, 99]], t=np.array([0.0, 10.0, 1.0, 100.0])))
     with pytest.raises(ConfigError, match=r"fewer than three recorded times t > 0"):
         creep_law(series([[0, 1, 2]], t=np.array([0.0, 1.0, 2.0])))
 

@@ -22,11 +22,16 @@ from slidernet.errors import ConfigError, param_error
 
 
 def _per_realization(values: xr.DataArray, owner: str) -> tuple[xr.DataArray, np.ndarray]:
-    """``values`` as (realization, t) and its recorded times (float64, tau_th); refused with other dims."""
+    """``values`` as (realization, t) and its recorded times (float64, tau_th); refused with other dims
+    or with times out of order."""
     if set(values.dims) != {"realization", "t"}:
         raise ConfigError(f"{owner} needs values of dims (realization, t); got {values.dims}.")
     values = values.transpose("realization", "t")
-    return values, values["t"].values.astype(np.float64)
+    t = values["t"].values.astype(np.float64)
+    # The windows and the default ends are found by position: the records must be in time order.
+    if not (np.isfinite(t).all() and (np.diff(t) > 0).all()):
+        raise ConfigError(f"{owner} needs finite, increasing recorded times t; got {t.tolist()}.")
+    return values, t
 
 
 def _mean_sem(a: np.ndarray) -> tuple[float, float]:
@@ -70,7 +75,8 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     Raises
     ------
     ConfigError
-        If ``values`` lacks the dims, or no time is left in [t_min, t_max].
+        If ``values`` lacks the dims or increasing times, ``t_min`` is not > 0, or fewer than two
+        times are left in [t_min, t_max].
 
     Examples
     --------
@@ -205,7 +211,7 @@ def creep_law(x_G: xr.DataArray, *, t_max: float | None = None, factor: float = 
     Raises
     ------
     ConfigError
-        If ``x_G`` lacks the dims, ``t_max``, ``factor`` or ``z`` is out of
+        If ``x_G`` lacks the dims or increasing times, ``t_max``, ``factor`` or ``z`` is out of
         range, or fewer than three distinct recorded times serve as t1 < t2 < t3.
 
     See Also
