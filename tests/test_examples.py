@@ -36,7 +36,7 @@ def assert_png(path: Path) -> None:
     assert path.read_bytes()[:8] == PNG_MAGIC, path
 
 
-@pytest.mark.parametrize("name", ["creep_irregular", "chain_aging", "aging_networks"], ids=str)
+@pytest.mark.parametrize("name", ["creep_irregular", "chain_aging", "aging_networks", "creep_networks"], ids=str)
 def test_help_names_the_options(name, capsys):
     module = load_example(name)
     with pytest.raises(SystemExit) as exc:
@@ -157,3 +157,30 @@ def test_aging_networks_quick(tmp_path):
     # At rest at t = 0 no spring is stretched: load ratio 0; thermal cycling loads the nodes.
     assert mech["load_ratio_t0_mean"] == 0.0
     assert mech["load_ratio_end_mean"] > 0.1
+
+
+def test_creep_networks_quick(tmp_path):
+    """The --quick preset (chains of 2 and 4 to 1e3 tau_th, irregular 16 to 300; 8 realizations, seed 1;
+    a few seconds): every point creeps downhill, steadily, with its numbers and errors."""
+    import json
+
+    study = load_example("creep_networks")
+    assert study.main(["--quick", "--out", str(tmp_path)]) == 0
+    assert_png(tmp_path / "creep_networks.png")
+    assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
+    data = json.loads((tmp_path / "creep_networks.json").read_text())
+    preset = study.PRESETS["quick"]
+    assert [(p["kind"], p["n"]) for p in data["points"]] == [(g.kind, n) for g in preset.groups for n in g.sizes]
+    assert data["parameters"]["f_ext_over_mu_d"] == 0.6
+    for p in data["points"]:
+        assert p["config"]["network"]["f_ext"] == 0.3 and p["realizations"] == preset.realizations
+        t1, t2, t3 = p["windows"]
+        assert t1 < t2 < t3 == p["steps"]
+        # Downhill creep, resolved: measured 4.4e-8 +- 0.05e-8 (chain 2) to 1.2e-7 +- 0.02e-7 (irregular 16).
+        assert p["v_last_decade_mean"] > 10 * p["v_last_decade_sem"] > 0
+        assert p["r_mean"] > 0 and p["step_per_slip_mean"] > 0
+        # The log law's ratio from the recorded times: near 1/10 for decade windows.
+        assert 0.08 < p["ratio_log"] < 0.12
+        # Measured ratios 0.95 +- 0.02 to 0.95 +- 0.05: logarithmic creep is rejected by more than 10 SE.
+        assert not p["log_consistent"] and p["verdict"] == "steady: logarithmic creep rejected"
+        assert abs(p["log_gap_mean"]) > 10 * p["log_gap_sem"]

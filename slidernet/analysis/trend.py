@@ -5,15 +5,42 @@ the last), so time bins of one trajectory are not independent samples and
 their scatter says nothing of the error of a trend. Realizations are
 independent (each has its own child of the seed): :func:`log_trend` fits
 each realization's own line against ln t and takes the standard error from
-the spread of those per-realization slopes.
+the spread of those per-realization slopes, and :func:`creep_law` tells
+steady from logarithmic creep by each realization's mean velocity over two
+successive log-spaced windows.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import xarray as xr
 
-from slidernet.errors import ConfigError
+from slidernet._validation import check_scalar
+from slidernet.errors import ConfigError, param_error
+
+
+def _per_realization(values: xr.DataArray, owner: str) -> tuple[xr.DataArray, np.ndarray]:
+    """``values`` as (realization, t) and its recorded times (float64, tau_th); refused with other dims
+    or with times out of order."""
+    if set(values.dims) != {"realization", "t"}:
+        raise ConfigError(f"{owner} needs values of dims (realization, t); got {values.dims}.")
+    values = values.transpose("realization", "t")
+    t = values["t"].values.astype(np.float64)
+    # The windows and the default ends are found by position: the records must be in time order.
+    if not (np.isfinite(t).all() and (np.diff(t) > 0).all()):
+        raise ConfigError(f"{owner} needs finite, increasing recorded times t; got {t.tolist()}.")
+    return values, t
+
+
+def _mean_sem(a: np.ndarray) -> tuple[float, float]:
+    """Mean and standard error std(ddof=1) / sqrt(count) of the finite values of ``a`` (one per
+    realization); NaN where there are none, and a NaN error with a single one."""
+    a = a[np.isfinite(a)]
+    if a.size == 0:
+        return np.nan, np.nan
+    return float(a.mean()), float(a.std(ddof=1) / np.sqrt(a.size)) if a.size > 1 else np.nan
 
 
 def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None) -> xr.Dataset:
@@ -48,7 +75,8 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     Raises
     ------
     ConfigError
-        If ``values`` lacks the dims, or no time is left in [t_min, t_max].
+        If ``values`` lacks the dims or increasing times, ``t_min`` is not > 0, or fewer than two
+        times are left in [t_min, t_max].
 
     Examples
     --------
@@ -63,12 +91,8 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     >>> round(float(out["slope_mean"]), 12), round(float(out["slope_sem"]), 12)
     (2.0, 1.0)
     """
-    if set(values.dims) != {"realization", "t"}:
-        raise ConfigError(f"log_trend needs values of dims (realization, t); got {values.dims}.")
-    if not t_min > 0:
-        raise ConfigError(f"The 't_min' parameter of log_trend must be > 0 (ln t). Got {t_min!r} instead.")
-    values = values.transpose("realization", "t")
-    t = values["t"].values.astype(np.float64)
+    values, t = _per_realization(values, "log_trend")
+    t_min = check_scalar(t_min, "t_min", "log_trend", "> 0")   # ln t
     keep = (t >= t_min) & (t <= (t[-1] if t_max is None else t_max))
     if keep.sum() < 2:
         raise ConfigError(f"log_trend: fewer than two recorded times in [{t_min}, {t_max}].")
@@ -84,15 +108,9 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     fitted = np.isfinite(slope)
     R = int(fitted.sum())
 
-    def mean_sem(a: np.ndarray) -> tuple[float, float]:
-        a = a[np.isfinite(a)]
-        if a.size == 0:
-            return np.nan, np.nan
-        return float(a.mean()), float(a.std(ddof=1) / np.sqrt(a.size)) if a.size > 1 else np.nan
-
-    s_mean, s_sem = mean_sem(slope)
-    a_mean, a_sem = mean_sem(np.where(fitted, y[:, 0], np.nan))
-    b_mean, b_sem = mean_sem(np.where(fitted, y[:, -1], np.nan))
+    s_mean, s_sem = _mean_sem(slope)
+    a_mean, a_sem = _mean_sem(np.where(fitted, y[:, 0], np.nan))
+    b_mean, b_sem = _mean_sem(np.where(fitted, y[:, -1], np.nan))
     units = values.attrs.get("units", "")
     out = xr.Dataset(
         {
@@ -108,5 +126,194 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
         },
         coords={"realization": values["realization"].values} if "realization" in values.coords else None,
         attrs={"t_start": float(t[keep][0]), "t_end": float(t[keep][-1]), "t_min": float(t_min)},
+    )
+    return out
+
+
+def _verdict(steady: bool, log: bool) -> str:
+    """The test's answer in words, from whether each law's prediction survived."""
+    if steady and not log:
+        return "steady: logarithmic creep rejected"
+    if log and not steady:
+        return "logarithmic: steady creep rejected"
+    if steady and log:
+        return "undecided: both laws within the error"
+    return "neither law: both rejected"
+
+
+def creep_law(x_G: xr.DataArray, *, t_max: float | None = None, factor: float = 10.0,
+              z: float = 2.0) -> xr.Dataset:
+    """Steady (x_G ∝ t) or logarithmic (x_G ∝ ln t) creep: mean velocities over two log-spaced windows.
+
+    Every realization r gets its mean velocity over an early and a late
+    window that are equally wide in ln t,
+
+        v_early,r = (x_r(t2) - x_r(t1)) / (t2 - t1),
+        v_late,r  = (x_r(t3) - x_r(t2)) / (t3 - t2),
+
+    with t3 = t_max, t2 = t_max / factor and t1 = t_max / factor**2, each
+    taken as the recorded time nearest to it in ln t (the times used are
+    returned). No interpolation: the mean velocity over a window is exact
+    whatever happens inside it. The two laws predict the ratio
+    v_late / v_early from the times used:
+
+    * steady creep, x = a + v t: 1;
+    * logarithmic creep, x = a + c ln t:
+      [ln(t3/t2) / (t3 - t2)] / [ln(t2/t1) / (t2 - t1)], which is 1/factor
+      (0.1 for decades) when the windows are exactly geometric.
+
+    Errors come from the spread over independent realizations, never from
+    the times of one trajectory. The ensemble ratio is the ratio of the mean
+    velocities, rho = <v_late> / <v_early>, not the mean of per-realization
+    ratios: a realization whose early velocity is near 0 (or negative, from
+    noise) would make its own ratio explode. Its standard error is the delta
+    method's, computed as the spread of each realization's linearised
+    contribution (v_late,r - rho v_early,r) / <v_early>, which keeps the
+    covariance of the two velocities of one realization. It only means
+    something while <v_early> is resolved (``early_resolved``), so the
+    verdicts do not rest on it: each law's prediction rho_h is tested by the
+    per-realization contrast g_r = v_late,r - rho_h v_early,r, linear in the
+    data, whose mean is 0 under the law whatever <v_early> is; the law is
+    consistent when |<g>| <= z SE(<g>) (Fieller's test of a ratio; a gap
+    within 1e-12 of the velocities is rounding, and passes).
+
+    Parameters
+    ----------
+    x_G : xarray.DataArray, dims (realization, t)
+        A per-realization displacement (``x_G`` of a result, in l0) at the
+        recorded times t (coordinate ``t``, in tau_th).
+    t_max : float, optional
+        End of the late window, in tau_th, within the recorded times
+        (default: the last one).
+    factor : float
+        Width of each window as a ratio of times, > 1 (10: two decades).
+    z : float
+        The verdicts' threshold, in standard errors (> 0).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``v_early``, ``v_late`` (realization,): each realization's mean
+        velocity in the units of ``x_G`` per tau_th (NaN for a realization
+        not finite at t1, t2 or t3, left out of everything else);
+        ``v_early_mean``, ``v_early_sem``, ``v_late_mean``, ``v_late_sem``;
+        ``ratio``, ``ratio_sem`` (rho and its delta-method error);
+        ``ratio_steady`` (1), ``ratio_log`` (the predictions);
+        ``steady_gap_mean``, ``steady_gap_sem``, ``log_gap_mean``,
+        ``log_gap_sem`` (the contrasts <g> and their errors, units of the
+        velocities); ``steady_consistent``, ``log_consistent`` (bool:
+        |<g>| <= z SE); ``early_resolved`` (bool: |<v_early>| > z SE, the
+        ratio is meaningful); ``realizations`` (R). Attributes ``t1``,
+        ``t2``, ``t3`` (the times used), ``factor``, ``z`` and ``verdict``,
+        the answer in words. With a single realization the errors are NaN
+        and the verdict says neither law.
+
+    Raises
+    ------
+    ConfigError
+        If ``x_G`` lacks the dims or increasing times, ``t_max``, ``factor`` or ``z`` is out of
+        range, or fewer than three distinct recorded times serve as t1 < t2 < t3.
+
+    See Also
+    --------
+    log_trend : the slope of a variable against ln t, per realization.
+
+    Examples
+    --------
+    Two realizations creeping steadily at 1 and 2 l0 per tau_th (exact
+    lines; errors from their spread), then two creeping logarithmically:
+
+    >>> t = np.array([0.0, 1.0, 10.0, 100.0, 1000.0])
+    >>> steady = xr.DataArray([1.0 * t, 2.0 * t], dims=("realization", "t"), coords={"t": t})
+    >>> out = creep_law(steady)
+    >>> out.attrs["t1"], out.attrs["t2"], out.attrs["t3"]
+    (10.0, 100.0, 1000.0)
+    >>> out["v_early"].values.tolist(), out["v_late"].values.tolist()
+    ([1.0, 2.0], [1.0, 2.0])
+    >>> float(out["ratio"]), float(out["ratio_log"]), out.attrs["verdict"]
+    (1.0, 0.1, 'steady: logarithmic creep rejected')
+    >>> ln_t = np.log(np.maximum(t, 1.0))
+    >>> logarithmic = xr.DataArray([2.0 * ln_t, 5.0 * ln_t], dims=("realization", "t"), coords={"t": t})
+    >>> out = creep_law(logarithmic)
+    >>> round(float(out["ratio"]), 12), out.attrs["verdict"]
+    (0.1, 'logarithmic: steady creep rejected')
+    """
+    owner = "creep_law"
+    values, t = _per_realization(x_G, owner)
+    factor = check_scalar(factor, "factor", owner, "> 1")
+    z = check_scalar(z, "z", owner, "> 0")
+    positive = t[t > 0]   # ln t
+    if positive.size < 3:
+        raise ConfigError(f"{owner}: fewer than three recorded times t > 0; got {t.tolist()}.")
+    if t_max is None:
+        t_max = float(positive[-1])
+    t_max = check_scalar(t_max, "t_max", owner, "> 0")
+    if t_max > positive[-1]:
+        raise param_error("t_max", owner, f"<= the last recorded time {float(positive[-1])!r}", t_max)
+    targets = np.array([t_max / factor**2, t_max / factor, t_max])
+    if targets[0] < positive[0]:
+        raise ConfigError(
+            f"{owner}: the early window starts at t_max / factor**2 = {float(targets[0])!r}, before the first "
+            f"recorded time t > 0 ({float(positive[0])!r}); lower factor or raise t_max."
+        )
+    nearest = np.abs(np.log(positive)[None, :] - np.log(targets)[:, None]).argmin(axis=1)
+    t1, t2, t3 = (float(positive[i]) for i in nearest)
+    if not t1 < t2 < t3:
+        raise ConfigError(
+            f"{owner}: the recorded times nearest to {targets.tolist()} are {[t1, t2, t3]}, not three "
+            "distinct times; record more densely (record = \"log\") or widen the windows (factor)."
+        )
+
+    at = values.values[:, np.searchsorted(t, [t1, t2, t3])].astype(np.float64)
+    usable = np.isfinite(at).all(axis=1)
+    at[~usable] = np.nan
+    v_early = (at[:, 1] - at[:, 0]) / (t2 - t1)
+    v_late = (at[:, 2] - at[:, 1]) / (t3 - t2)
+    R = int(usable.sum())
+
+    e_mean, e_sem = _mean_sem(v_early)
+    l_mean, l_sem = _mean_sem(v_late)
+    ratio = l_mean / e_mean if e_mean != 0 else math.nan
+    # Delta method: rho - rho_true ~ <v_late - rho v_early> / <v_early>, a mean of independent
+    # per-realization terms; its spread keeps the covariance of v_early and v_late.
+    ratio_sem = _mean_sem((v_late - ratio * v_early) / e_mean)[1] if math.isfinite(ratio) else math.nan
+    ratio_log = (math.log(t3 / t2) / (t3 - t2)) / (math.log(t2 / t1) / (t2 - t1))
+
+    gaps = {}
+    for name, predicted in (("steady", 1.0), ("log", ratio_log)):
+        g_mean, g_sem = _mean_sem(v_late - predicted * v_early)
+        # Rounding is no evidence: exact synthetic laws have SE ~ 0 and a gap of a few ulps.
+        rounding = 1e-12 * (abs(l_mean) + predicted * abs(e_mean))
+        # NaN errors (one realization) compare False: no law is then called consistent.
+        gaps[name] = (g_mean, g_sem, bool(abs(g_mean) <= z * g_sem + rounding))
+    early_resolved = bool(abs(e_mean) > z * e_sem)
+
+    units = values.attrs.get("units", "")
+    v_units = f"{units} / tau_th" if units else "per tau_th"
+    v_attrs = {"units": v_units}
+    out = xr.Dataset(
+        {
+            "v_early": ("realization", v_early, {"long_name": "mean velocity over [t1, t2]", **v_attrs}),
+            "v_late": ("realization", v_late, {"long_name": "mean velocity over [t2, t3]", **v_attrs}),
+            "v_early_mean": ((), e_mean, v_attrs),
+            "v_early_sem": ((), e_sem, v_attrs),
+            "v_late_mean": ((), l_mean, v_attrs),
+            "v_late_sem": ((), l_sem, v_attrs),
+            "ratio": ((), ratio, {"long_name": "<v_late> / <v_early>", "units": "1"}),
+            "ratio_sem": ((), ratio_sem, {"long_name": "standard error of ratio (delta method)", "units": "1"}),
+            "ratio_steady": ((), 1.0, {"long_name": "ratio predicted by steady creep", "units": "1"}),
+            "ratio_log": ((), ratio_log, {"long_name": "ratio predicted by logarithmic creep", "units": "1"}),
+            "steady_gap_mean": ((), gaps["steady"][0], {"long_name": "<v_late - v_early>", **v_attrs}),
+            "steady_gap_sem": ((), gaps["steady"][1], v_attrs),
+            "log_gap_mean": ((), gaps["log"][0], {"long_name": "<v_late - ratio_log v_early>", **v_attrs}),
+            "log_gap_sem": ((), gaps["log"][1], v_attrs),
+            "steady_consistent": ((), gaps["steady"][2]),
+            "log_consistent": ((), gaps["log"][2]),
+            "early_resolved": ((), early_resolved),
+            "realizations": ((), R),
+        },
+        coords={"realization": values["realization"].values} if "realization" in values.coords else None,
+        attrs={"t1": t1, "t2": t2, "t3": t3, "factor": factor, "z": z,
+               "verdict": _verdict(gaps["steady"][2], gaps["log"][2])},
     )
     return out
