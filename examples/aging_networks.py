@@ -40,8 +40,8 @@ slip, and the load at which one of its avalanches first set every slider in
 motion, above mu_d or not, so that the answer does not rest on the tilt
 test's sliding rule alone.
 
-Cuts of the grid: 4096 sliders only in the ``large`` preset (4 realizations,
-to 100 tau_th, 5 recorded times per decade: the tilt test's cost grows
+Cuts of the grid: 4096 sliders only in the ``large`` preset (8 realizations,
+to 300 tau_th, 5 recorded times per decade: the tilt test's cost grows
 fastest with size); std 0.02 and 0.03 not at 256 or 1024 sliders; sigma_theta / Ntilde =
 10 only at std 0.01, only to 1e3 tau_th for the irregular networks and not
 at 256 or above; 256 sliders only to 3e3 tau_th, 1024 to 300 tau_th.
@@ -152,10 +152,10 @@ PRESETS = {
         mechanism=(("chain", 2, 10_000), ("chain", 4, 10_000), ("chain", 16, 10_000),
                    ("irregular", 16, 10_000), ("irregular", 64, 10_000)),
     ),
-    # Beyond the full preset's budget: 4096 sliders, a few realizations, to 100 tau_th.
+    # Beyond the full preset's budget: 4096 sliders, 8 realizations, to 300 tau_th.
     "large": Preset(
-        realizations=4,
-        groups=(Group("irregular_4096", "irregular", (4096,), (0.01,), 1.0, 100, per_decade=5),),
+        realizations=8,
+        groups=(Group("irregular_4096", "irregular", (4096,), (0.01,), 1.0, 300, per_decade=5),),
         mechanism=(),
     ),
     "quick": Preset(
@@ -241,13 +241,13 @@ def _below(values: xr.DataArray, mu_d: float) -> dict[str, Any]:
 
 
 def run_group(group: Group, realizations: int, workers: int | None, out: Path | None, resume: bool,
-              log: bool = True) -> list[dict[str, Any]]:
+              log: bool = True, scheduler: str | None = None) -> list[dict[str, Any]]:
     """Run one sweep and reduce every point to its numbers."""
     cfg = group_config(group, realizations)
     grid: dict[str, list[Any]] = {"network.n": list(group.sizes), "friction.static.std": list(group.stds)}
     start = time.perf_counter()
     where = None if out is None else out / "sweeps" / group.name
-    result = sweep(cfg, grid, workers=workers, out=where, resume=resume and where is not None
+    result = sweep(cfg, grid, workers=workers, scheduler=scheduler, out=where, resume=resume and where is not None
                    and (where / "sweep.json").exists(), overwrite=not resume, progress=None)
     ds = result.to_dataset() if isinstance(result, xr.DataTree) else result
     configs = json.loads(ds.attrs["configs"])
@@ -319,7 +319,10 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     fig = Figure(figsize=(11, 8.5), layout="constrained")
     FigureCanvasAgg(fig)
     (ax_t, ax_s), (ax_x, ax_m) = fig.subplots(2, 2)
-    base = [p for p in data["points"] if p["std"] == 0.01 and p["sigma_theta_over_Ntilde"] == 1.0]
+    # The replica (another seed) is drawn on its own in panel (b), not as a second curve.
+    replica = [p for p in data["points"] if p["group"] == "chains_replica"]
+    first = [p for p in data["points"] if p["group"] != "chains_replica"]
+    base = [p for p in first if p["std"] == 0.01 and p["sigma_theta_over_Ntilde"] == 1.0]
     for c, p in enumerate(base):
         cur = p["curves"]["mu_eff"]
         t, m, s = np.array(cur["t"], float), np.array(cur["mean"]), np.array(cur["sem"])
@@ -340,7 +343,7 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     markers = {("chain", 1.0): "o", ("irregular", 1.0): "s", ("chain", 10.0): "^", ("irregular", 10.0): "D"}
     for (kind, ratio), mk in markers.items():
         for k, std in enumerate((0.01, 0.02, 0.03)):
-            pts = [p for p in data["points"] if p["kind"] == kind and p["sigma_theta_over_Ntilde"] == ratio
+            pts = [p for p in first if p["kind"] == kind and p["sigma_theta_over_Ntilde"] == ratio
                    and p["std"] == std]
             if not pts:
                 continue
@@ -354,6 +357,11 @@ def plot(data: dict[str, Any], path: Path) -> Path:
                               yerr=[p["x_G2"]["slope_per_ln_t_sem"] for p in pts], fmt=mk + "-", ms=4,
                               color="C0" if ratio == 1.0 else "C3",
                               label=f"{kind}, " + rf"$\sigma_\theta/\tilde N$ = {ratio:g}")
+    if replica:
+        ax_s.errorbar([p["n"] * 0.96 for p in replica], [p["mu_eff"]["slope_per_decade_mean"] for p in replica],
+                      yerr=[p["mu_eff"]["slope_per_decade_sem"] for p in replica], fmt="*", ms=7, color="k",
+                      label=f"chain, std 0.01, replica (seed {replica[0]['seed']}, "
+                            f"{replica[0]['realizations']} realizations)")
     ax_s.axhline(0, color="k", lw=0.6)
     ax_s.set_xscale("log")
     ax_s.set_xlabel("number of sliders N")
@@ -414,9 +422,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="a small grid, short runs (seconds); "
                         "the same as --preset quick")
     parser.add_argument("--preset", choices=sorted(PRESETS), default="full",
-                        help="full (the study, about 13 min on 2 cores), quick, or large (4096 sliders, "
+                        help="full (the study, about 9 min on 2 cores), quick, or large (4096 sliders, "
                              "beyond the full preset's budget)")
     parser.add_argument("--workers", type=int, default=None, help="worker processes per sweep point")
+    parser.add_argument("--scheduler", default=None,
+                        help="a Dask scheduler address, e.g. tcp://host:8786: realizations run on that cluster")
     parser.add_argument("--resume", action="store_true",
                         help="continue the sweeps of an interrupted run in --out (points already done are kept)")
     args = parser.parse_args(argv)
@@ -427,7 +437,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     base = base_config(preset.realizations)
     points: list[dict[str, Any]] = []
     for group in preset.groups:
-        points += run_group(group, preset.realizations, args.workers, args.out, args.resume)
+        points += run_group(group, preset.realizations, args.workers, args.out, args.resume,
+                            scheduler=args.scheduler)
     mech = [mechanism(kind, n, steps, preset.realizations) for kind, n, steps in preset.mechanism]
     data = {
         "question": "does thermal cycling increase mu_eff with time in networks of sliders?",
