@@ -174,7 +174,7 @@ def creep_law(x_G: xr.DataArray, *, t_max: float | None = None, factor: float = 
     verdicts do not rest on it: each law's prediction rho_h is tested by the
     per-realization contrast g_r = v_late,r - rho_h v_early,r, linear in the
     data, whose mean is 0 under the law whatever <v_early> is; the law is
-    consistent when |<g>| <= z SE(<g>) (Fieller's test of a ratio; a gap
+    consistent when abs(<g>) <= z SE(<g>) (Fieller's test of a ratio; a gap
     within 1e-12 of the velocities is rounding, and passes).
 
     Parameters
@@ -202,7 +202,7 @@ def creep_law(x_G: xr.DataArray, *, t_max: float | None = None, factor: float = 
         ``steady_gap_mean``, ``steady_gap_sem``, ``log_gap_mean``,
         ``log_gap_sem`` (the contrasts <g> and their errors, units of the
         velocities); ``steady_consistent``, ``log_consistent`` (bool:
-        |<g>| <= z SE); ``early_resolved`` (bool: |<v_early>| > z SE, the
+        abs(<g>) <= z SE); ``early_resolved`` (bool: abs(<v_early>) > z SE, the
         ratio is meaningful); ``realizations`` (R). Attributes ``t1``,
         ``t2``, ``t3`` (the times used), ``factor``, ``z`` and ``verdict``,
         the answer in words. With a single realization the errors are NaN
