@@ -76,7 +76,7 @@ import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
 from slidernet.analysis.trend import log_trend
 from slidernet.ensemble.sweep import sweep
-from slidernet.io import save_figure
+from slidernet.io import save_figure, write_json
 
 try:
     BASE_TOML = Path(__file__).resolve().with_name("aging_networks.toml")
@@ -398,23 +398,6 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     return save_figure(fig, path, dpi=120)
 
 
-def _write_json(data: dict[str, Any], path: Path) -> Path:
-    """Write ``data`` atomically (NaN as null)."""
-    def clean(v: Any) -> Any:
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return v
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(json.dumps(clean(data), indent=1))
-    tmp.replace(path)
-    return path
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
@@ -456,7 +439,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "wall_time_s": None,
     }
     data["wall_time_s"] = time.perf_counter() - start
-    print(_write_json(data, args.out / JSON_NAME))
+    print(write_json(data, args.out / JSON_NAME))
     print(plot(data, args.out / PNG_NAME))
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0

@@ -58,7 +58,7 @@ from matplotlib.figure import Figure
 import slidernet
 from slidernet.analysis.trend import creep_law
 from slidernet.ensemble.sweep import sweep
-from slidernet.io import atomic_output, save_figure
+from slidernet.io import save_figure, write_json
 
 try:
     BASE_TOML = Path(__file__).resolve().with_name("creep_networks.toml")
@@ -272,21 +272,6 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     return save_figure(fig, path, dpi=120)
 
 
-def _write_json(data: dict[str, Any], path: Path) -> Path:
-    """Write ``data`` atomically (temporary file, then rename; NaN as null)."""
-    def clean(v: Any) -> Any:
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return v
-    with atomic_output(path) as tmp:
-        Path(tmp).write_text(json.dumps(clean(data), indent=1))
-    return path
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point; returns the exit status."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
@@ -331,7 +316,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "slidernet_version": slidernet.__version__,
         "wall_time_s": time.perf_counter() - start,
     }
-    print(_write_json(data, args.out / JSON_NAME))
+    print(write_json(data, args.out / JSON_NAME))
     print(plot(data, args.out / PNG_NAME))
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0

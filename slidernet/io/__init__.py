@@ -1,4 +1,4 @@
-"""Files: atomic writes, result files (netCDF), the checkpoint folder of a run, checkpoints of a realization.
+"""Files: atomic writes, result files (netCDF), JSON summaries, the checkpoint folder of a run, checkpoints.
 
 ``slidernet.io`` itself holds the plain file helpers and the two writers of a
 result file, which share one encoding (:mod:`slidernet.io.netcdf`);
@@ -14,5 +14,7 @@ from slidernet.io.netcdf import (
     save_figure,
     write_netcdf,
 )
+from slidernet.io.summary import write_json
 
-__all__ = ["atomic_output", "read_result", "result_config", "result_writer", "save_figure", "write_netcdf"]
+__all__ = ["atomic_output", "read_result", "result_config", "result_writer", "save_figure", "write_json",
+           "write_netcdf"]
