@@ -3,9 +3,10 @@
     python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--repeat 3] [--sizes L ...] [--core 1]
                                     [--csv PATH] [--no-delaunay] [--paper]
 
-The yardsticks are two plain C programs that solve the same model the
+The yardsticks are plain C programs that solve the same model the
 straightforward way, on one core: ``twoslider_loop.c`` (the paper's two
-sliders) and ``lattice.c`` (a triangular lattice with free boundaries). They
+sliders), ``lattice.c`` (a triangular lattice with free boundaries) and
+``network.c`` (any 2D network read from a file). They
 are not part of slidernet and do not ship with it: point ``--anchors`` (or
 the environment variable ``SLIDERNET_ANCHORS``) at the folder that holds
 them. The script builds them with ``cc -O3 -march=native`` in a temporary
@@ -49,7 +50,15 @@ The rows (rates in millions of rearrangements, i.e. slips, per second):
    the largest lattice, 2 steps (every node is driven: about 20 N slips a
    step), its kernel rate against the triangular one of row 5, its setup and
    peak memory (``--no-delaunay`` leaves it out: about 45 s at 1e6);
-8. with ``--paper``: ``slidernet paper`` (full preset, all cores), wall time
+8. irregular networks of 1e4 nodes (400 steps) and 1e6 nodes (6 steps),
+   Ntilde = sigma_theta = 1e-7, network seed 0, kernel alone, against
+   ``network FILE 1e-7 1e-7 steps 1`` on the same network: the child writes
+   slidernet's own network (positions, springs) to FILE in network.c's text
+   format before it runs (``--no-irregular-c`` leaves these rows out;
+   network.c is optional in ``--anchors``);
+9. the irregular rate at 1e6 nodes over the rate at 1e4, slidernet's and
+   network.c's;
+10. with ``--paper``: ``slidernet paper`` (full preset, all cores), wall time
    and the peak resident memory of its largest process (about 2 minutes).
 
 The target column holds the performance issue's targets (for a ratio,
@@ -91,6 +100,10 @@ from typing import Any
 PAIR = {"mu_d": 0.5, "mean": 0.6, "std": 0.01, "Ntilde": 1e-7, "sigma_theta": 1e-6}
 LATTICE = {"Ntilde": 1e-7, "sigma_theta": 1e-7}
 SMALL = 32  # the ~1e3-node lattice of rows 4 and 6
+# Rows 8 and 9: (nodes, thermal steps) of the irregular networks against network.c; about 8e7 and
+# 7e7 slips (every node is driven: about 20 N slips a step at sigma_theta / Ntilde = 1).
+IRREGULAR = ((10_000, 400), (1_000_000, 6))
+IRREGULAR_Q = ((1_000, 100), (10_000, 10))
 
 
 # ---------------------------------------------------------------------------
@@ -117,6 +130,15 @@ def _lattice_config(size: int, steps: int, kind: str = "triangular") -> dict[str
     return {
         "steps": steps, "record": "log",
         "network": {**network, "Ntilde": LATTICE["Ntilde"]},
+        "friction": _friction(),
+        "driver": {"name": "gaussian_steps", "sigma_theta": LATTICE["sigma_theta"]},
+    }
+
+
+def _irregular_config(n: int, steps: int) -> dict[str, Any]:
+    return {
+        "seed": 1, "realizations": 1, "steps": steps, "record": [0, steps],
+        "network": {"kind": "irregular", "n": n, "seed": 0, "Ntilde": LATTICE["Ntilde"]},
         "friction": _friction(),
         "driver": {"name": "gaussian_steps", "sigma_theta": LATTICE["sigma_theta"]},
     }
@@ -202,7 +224,38 @@ def child_lattice(size: int, steps: int, kind: str = "triangular") -> dict[str, 
             "rss_before_setup_GB": rss0, "rss_after_setup_GB": rss1}
 
 
-CHILDREN = {"pair": child_pair, "workers": child_workers, "lattice": child_lattice}
+def child_irregular(n: int, steps: int, file: str) -> dict[str, Any]:
+    """Rows 8 and 9: one realization of an irregular network of n nodes, also written to ``file`` for network.c.
+
+    The file (untimed, before the realization) holds the network's node
+    positions (l0) and springs in network.c's text format, so that both
+    programs solve the same network.
+    """
+    import numpy as np
+
+    from slidernet.config import load_config
+    from slidernet.solver import Realization, Scene
+
+    Realization(Scene.from_config(load_config(_irregular_config(16, 2))), np.random.SeedSequence(0)).advance()
+    t0 = time.perf_counter()
+    scene = Scene.from_config(load_config(_irregular_config(n, steps)))
+    t1 = time.perf_counter()
+    net = scene.network
+    with open(file, "w") as fh:
+        fh.write(f"{net.n_nodes} {net.n_edges}\n")
+        np.savetxt(fh, net.positions, fmt="%.17g")
+        np.savetxt(fh, net.edges, fmt="%d")
+    t2 = time.perf_counter()
+    real = Realization(scene, np.random.SeedSequence(1))
+    t3 = time.perf_counter()
+    real.advance()
+    t4 = time.perf_counter()
+    mu = real.thresholds
+    return {"slips": real.n, "setup": (t1 - t0) + (t3 - t2), "kernel_s": t4 - t3, "rate": real.n / (t4 - t3),
+            "mean_mu": float(mu.mean()), "mu_max": float(mu.max())}
+
+
+CHILDREN = {"pair": child_pair, "workers": child_workers, "lattice": child_lattice, "irregular": child_irregular}
 
 
 # ---------------------------------------------------------------------------
@@ -256,6 +309,9 @@ def build_anchors(folder: Path | None, tmp: Path) -> tuple[dict[str, Path], str]
     cc = next((c for c in ("cc", "gcc", "clang") if shutil.which(c)), None)
     if cc is None:
         return {}, "skipped (no C compiler)"
+    # network.c is newer than the other two: a folder without it still gives rows 1 to 7.
+    if (folder / "network.c").is_file():
+        sources["network"] = folder / "network.c"
     built = {}
     for name, src in sources.items():
         cmd = [cc, "-O3", "-march=native", "-o", str(tmp / name), str(src), "-lm"]
@@ -292,6 +348,20 @@ def c_lattice(exe: Path, size: int, steps: int, core: int | None) -> dict[str, A
     return {"slips": int(slips), "setup": setup, "kernel_s": total - setup, "rate": slips / (total - setup),
             "rate_with_setup": slips / total, "mean_mu": mean_mu, "mu_max": mu_max,
             "peak_GB": usage["peak_GB"], "cpu_share": usage["cpu"] / usage["wall"]}
+
+
+def c_network(exe: Path, file: str, steps: int, core: int | None) -> dict[str, Any]:
+    out, usage = _spawn([str(exe), file, str(LATTICE["Ntilde"]), str(LATTICE["sigma_theta"]), str(steps), "1"],
+                        core)
+    num = r"([0-9.eE+-]+|nan|inf)"
+    m = re.search(rf"slips {num} read {num} s setup {num} s total {num} s rate {num} slips/s \(run only {num}\) "
+                  rf"mean_mu {num} mu_max {num}", out)
+    if m is None:
+        raise RuntimeError(f"unexpected output of the network yardstick: {out!r}")
+    slips, _read, setup, total, _rate, _run_only, mean_mu, mu_max = (float(x) for x in m.groups())
+    return {"slips": int(slips), "setup": setup, "kernel_s": total - setup, "rate": slips / (total - setup),
+            "mean_mu": mean_mu, "mu_max": mu_max, "peak_GB": usage["peak_GB"],
+            "cpu_share": usage["cpu"] / usage["wall"]}
 
 
 def _median(runs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -412,7 +482,7 @@ def _pick_core(core: int) -> int | None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--anchors", type=Path, default=os.environ.get("SLIDERNET_ANCHORS") or None,
-                    help="folder with twoslider_loop.c and lattice.c (default: $SLIDERNET_ANCHORS)")
+                    help="folder with twoslider_loop.c, lattice.c and network.c (default: $SLIDERNET_ANCHORS)")
     ap.add_argument("--quick", action="store_true", help="short runs, a smoke test: noisy ratios")
     ap.add_argument("--sizes", type=int, nargs="+", default=None,
                     help="L of the large L x L lattices (default 1000; --quick: 100)")
@@ -420,6 +490,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
     ap.add_argument("--no-delaunay", action="store_true",
                     help="leave out the irregular (Delaunay) network as large as the largest lattice")
+    ap.add_argument("--no-irregular-c", action="store_true",
+                    help="leave out rows 8 and 9, the irregular networks against network.c (minutes at 1e6 nodes)")
     ap.add_argument("--repeat", type=int, default=3,
                     help="runs of rows 1 to 5, alternating slidernet and C, reported as medians (default 3)")
     ap.add_argument("--paper", action="store_true",
@@ -544,6 +616,31 @@ def main(argv: list[str] | None = None) -> int:
                       ours_text=f"{irr['rate'] / 1e6:.2f} M/s ({big['rate'] / irr['rate']:.2f} x slower than "
                                 f"triangular; setup {irr['setup']:.2f} s, peak {irr['peak_GB']:.2f} GB)",
                       slips=(irr["slips"], None), mu=(irr["mean_mu"], None))
+
+        # 8. irregular networks against network.c, the same network (written by slidernet), kernel alone
+        if not args.no_irregular_c:
+            irr_rates: dict[int, tuple[float, float | None]] = {}
+            for nodes, steps in IRREGULAR_Q if q else IRREGULAR:
+                file = str(Path(tmp) / f"irregular_{nodes}.txt")
+                ours_i, theirs_i, r_i, r_c_i = repeated(
+                    n, lambda nodes=nodes, steps=steps, file=file: run_child(
+                        "irregular", {"n": nodes, "steps": steps, "file": file}, core),
+                    (lambda steps=steps, file=file: c_network(exe["network"], file, steps, core))
+                    if "network" in exe else None)
+                shares += [ours_i["cpu_share"]] + ([theirs_i["cpu_share"]] if theirs_i else [])
+                irr_rates[nodes] = (ours_i["rate"], theirs_i and theirs_i["rate"])
+                table.add(f"irregular {nodes:,} nodes, {steps} steps, kernel alone (vs network.c)", "M/s",
+                          ours_i["rate"], theirs_i and theirs_i["rate"], target=">= 2.5",
+                          ratio=None if "network" in exe or not exe else "skipped (no network.c)",
+                          slips=(ours_i["slips"], theirs_i and theirs_i["slips"]),
+                          mu=(ours_i["mean_mu"], theirs_i and theirs_i["mean_mu"]),
+                          ours_text=f"{ours_i['rate'] / 1e6:.2f} M/s{_spread(r_i, r_c_i)}")
+            # 9. the rate's fall with size
+            by_size = sorted(irr_rates.items())
+            (n_lo, (o_lo, c_lo)), (n_hi, (o_hi, c_hi)) = by_size[0], by_size[-1]
+            if n_hi != n_lo:
+                table.add(f"irregular: rate at {n_hi:,} / at {n_lo:,} nodes, kernel alone", "x", o_hi / o_lo,
+                          c_hi / c_lo if c_hi and c_lo else None, target=">= 0.5")
 
     if args.paper:
         out = Path(tempfile.mkdtemp(prefix="slidernet-paper-"))
