@@ -53,7 +53,7 @@ import xarray as xr
 
 import slidernet
 from slidernet import kernels
-from slidernet.analysis.trend import log_trend
+from slidernet.analysis.trend import log_trend, mean_sem
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import TiltTestError
@@ -121,9 +121,7 @@ def summary(values: np.ndarray, t: np.ndarray, T: int) -> dict[str, Any]:
     values: shape (R, len(t)).
     """
     def at(time: int) -> tuple[float, float]:
-        v = values[:, int(np.flatnonzero(t == time)[0])]
-        v = v[np.isfinite(v)]
-        return float(v.mean()), float(v.std(ddof=1) / math.sqrt(v.size))
+        return mean_sem(values[:, int(np.flatnonzero(t == time)[0])])[:2]
 
     trend = log_trend(xr.DataArray(values, dims=("realization", "t"), coords={"t": t.astype(float)}))
     ln10 = math.log(10.0)
@@ -196,8 +194,8 @@ def rate_check(n: int, args: argparse.Namespace) -> dict[str, Any]:
     """The ramp-rate effect: the dynamics' states of the first R realizations tested at rate x 10 and rate / 10.
 
     Each state is tested three times from the same redraw stream (spawn key (r, 3, k)); the differences
-    of mu_eff, all_moving and certified against the test at ``rate``, mean +- SE over the tests (the
-    records of a realization are taken as independent here: a rough error) and the largest |difference|.
+    of mu_eff, all_moving and certified against the test at ``rate``: each realization's mean over its
+    records, then mean +- SE over the R realizations, and the largest |difference| of any test.
     """
     cfg = config(n, args.steps, args.realizations, args.seed)
     dyn = Dynamics(Scene.from_config(load_config(cfg)), tau_ratio=args.tau_ratio, max_step=args.max_step)
@@ -206,20 +204,23 @@ def rate_check(n: int, args: argparse.Namespace) -> dict[str, Any]:
     rows = []
     for r in range(args.rate_check):
         out = dyn.run(seeds[r], states=True)
+        per_record = []
         for k in range(out["t"].size):
             row = []
             for rate in rates:
                 rng = np.random.default_rng(np.random.SeedSequence(args.seed, spawn_key=(r, KEY_DYN, k)))
                 res = dyn.tilt_test(out["u"][k], out["mu_s"][k], rng, theta=float(out["theta"][k]), rate=rate)
                 row.append([res["mu_eff"], res["all_moving"], res["certified"]])
-            rows.append(row)
-    a = np.array(rows)  # (tests, rate, load)
-    result: dict[str, Any] = {"n": n, "rates": rates, "tests": len(rows), "values": a.tolist()}
+            per_record.append(row)
+        rows.append(per_record)
+    a = np.array(rows)  # (realization, record, rate, load)
+    result: dict[str, Any] = {"n": n, "rates": rates, "tests": int(a.shape[0] * a.shape[1]), "values": a.tolist()}
     for j, load in enumerate(("mu_eff", "all_moving", "certified")):
         for i, label in ((0, "x10"), (2, "/10")):
-            d = a[:, i, j] - a[:, 1, j]
-            result[f"{load} {label}"] = (float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size)),
-                                         float(np.abs(d).max()))
+            d = a[:, :, i, j] - a[:, :, 1, j]
+            # The records of one realization are not independent: average within it first.
+            mean, sem, _ = mean_sem(d.mean(axis=1))
+            result[f"{load} {label}"] = (mean, sem, float(np.abs(d).max()))
     return result
 
 

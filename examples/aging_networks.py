@@ -74,7 +74,7 @@ from matplotlib.figure import Figure
 
 import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
-from slidernet.analysis.trend import log_trend
+from slidernet.analysis.trend import log_trend, mean_sem
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import save_figure, write_json
 
@@ -191,19 +191,10 @@ def group_config(group: Group, realizations: int) -> dict[str, Any]:
     return cfg
 
 
-def _mean_sem(a: np.ndarray) -> tuple[float, float, int]:
-    """Mean, standard error and count of the finite values of ``a`` (one per realization)."""
-    a = np.asarray(a, dtype=np.float64)
-    a = a[np.isfinite(a)]
-    if a.size == 0:
-        return math.nan, math.nan, 0
-    return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)) if a.size > 1 else math.nan, int(a.size)
-
-
 def _trend(values: xr.DataArray) -> dict[str, Any]:
     """log_trend of one per-realization variable, with its value at t = 0, as plain numbers."""
     tr = log_trend(values, t_min=1)
-    t0_mean, t0_sem, t0_count = _mean_sem(values.sel(t=0).values)
+    t0_mean, t0_sem, t0_count = mean_sem(values.sel(t=0).values)
     return {
         "t0_mean": t0_mean, "t0_sem": t0_sem, "t0_realizations": t0_count,
         "start_mean": float(tr["start_mean"]), "start_sem": float(tr["start_sem"]),
@@ -236,7 +227,7 @@ def _below(values: xr.DataArray, mu_d: float) -> dict[str, Any]:
     tested = np.isfinite(v)
     frac = np.where(tested.any(axis=1), (tested & (v < mu_d)).sum(axis=1) / np.maximum(tested.sum(axis=1), 1),
                     np.nan)
-    mean, sem, count = _mean_sem(frac)
+    mean, sem, count = mean_sem(frac)
     return {"mean": mean, "sem": sem, "realizations": count}
 
 
@@ -305,8 +296,8 @@ def mechanism(kind: str, n: int, steps: int, realizations: int, log: bool = True
     # The change per realization, so that its error comes from independent realizations.
     shift = (states["mu_s"].isel(t=1) - states["mu_s"].isel(t=0)).mean("node").values
     ratio = (states["load_ratio"].isel(t=1) - states["load_ratio"].isel(t=0)).mean("node").values
-    out["mu_s_change_mean"], out["mu_s_change_sem"], _ = _mean_sem(shift)
-    out["load_ratio_change_mean"], out["load_ratio_change_sem"], _ = _mean_sem(ratio)
+    out["mu_s_change_mean"], out["mu_s_change_sem"], _ = mean_sem(shift)
+    out["load_ratio_change_mean"], out["load_ratio_change_sem"], _ = mean_sem(ratio)
     if log:
         print(f"mechanism {kind} {n}: shift {out['mu_s_shift_t0_mean']:+.5f} -> "
               f"{out['mu_s_shift_end_mean']:+.5f}, "

@@ -56,7 +56,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import slidernet
-from slidernet.analysis.trend import creep_law
+from slidernet.analysis.trend import creep_law, mean_sem
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import save_figure, write_json
 
@@ -139,15 +139,6 @@ def group_config(group: Group, realizations: int) -> dict[str, Any]:
     return cfg
 
 
-def _mean_sem(a: np.ndarray) -> tuple[float, float]:
-    """Mean and standard error of the finite values of ``a`` (one per realization)."""
-    a = np.asarray(a, dtype=np.float64)
-    a = a[np.isfinite(a)]
-    if a.size == 0:
-        return math.nan, math.nan
-    return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)) if a.size > 1 else math.nan
-
-
 def _velocity_curve(x_G: xr.DataArray, per_decade: int = 4) -> dict[str, list[float]]:
     """Mean velocity of the ensemble over successive log-spaced windows from t = 1 to the end.
 
@@ -162,9 +153,9 @@ def _velocity_curve(x_G: xr.DataArray, per_decade: int = 4) -> dict[str, list[fl
     edges = np.unique(positive[np.abs(np.log(positive)[None, :] - np.log(wanted)[:, None]).argmin(axis=1)])
     idx = np.searchsorted(t, edges)
     v = np.diff(x.values[:, idx], axis=1) / np.diff(edges)
-    stats = [_mean_sem(v[:, k]) for k in range(v.shape[1])]
+    stats = [mean_sem(v[:, k]) for k in range(v.shape[1])]
     return {"t": np.sqrt(edges[:-1] * edges[1:]).tolist(), "t_from": edges[:-1].tolist(),
-            "t_to": edges[1:].tolist(), "v_mean": [m for m, _ in stats], "v_sem": [s for _, s in stats]}
+            "t_to": edges[1:].tolist(), "v_mean": [m for m, _, _ in stats], "v_sem": [s for _, s, _ in stats]}
 
 
 def reduce_point(one: xr.Dataset, n: int) -> dict[str, Any]:
@@ -173,13 +164,13 @@ def reduce_point(one: xr.Dataset, n: int) -> dict[str, Any]:
     t2, t3 = law.attrs["t2"], law.attrs["t3"]
     x, slips = one["x_G"], one["n"]
     # The whole-run mean velocity x_G(T) / T, per realization.
-    v_run = _mean_sem((x.sel(t=t3) - x.sel(t=0)).values / t3)
+    v_run = mean_sem((x.sel(t=t3) - x.sel(t=0)).values / t3)
     # One slip of one slider by delta moves x_G by delta / N: N v / r is the mean displacement along
     # x of the slider that slips, per slip (l0), measured over the last decade per realization.
     dx = (x.sel(t=t3) - x.sel(t=t2)).values
     dn = (slips.sel(t=t3) - slips.sel(t=t2)).values.astype(np.float64)
-    step = _mean_sem(np.where(dn > 0, n * dx / np.maximum(dn, 1), np.nan))
-    r_last = _mean_sem(dn / (t3 - t2))
+    step = mean_sem(np.where(dn > 0, n * dx / np.maximum(dn, 1), np.nan))
+    r_last = mean_sem(dn / (t3 - t2))
     return {
         "v_last_decade_mean": float(law["v_late_mean"]), "v_last_decade_sem": float(law["v_late_sem"]),
         "v_previous_decade_mean": float(law["v_early_mean"]), "v_previous_decade_sem": float(law["v_early_sem"]),

@@ -7,7 +7,8 @@ independent (each has its own child of the seed): :func:`log_trend` fits
 each realization's own line against ln t and takes the standard error from
 the spread of those per-realization slopes, and :func:`creep_law` tells
 steady from logarithmic creep by each realization's mean velocity over two
-successive log-spaced windows.
+successive log-spaced windows. :func:`mean_sem` is the rule under all of
+them: the mean of one value per realization and its standard error.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import math
 
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike
 
 from slidernet._validation import check_scalar
 from slidernet.errors import ConfigError, param_error
@@ -34,13 +36,37 @@ def _per_realization(values: xr.DataArray, owner: str) -> tuple[xr.DataArray, np
     return values, t
 
 
-def _mean_sem(a: np.ndarray) -> tuple[float, float]:
-    """Mean and standard error std(ddof=1) / sqrt(count) of the finite values of ``a`` (one per
-    realization); NaN where there are none, and a NaN error with a single one."""
+def mean_sem(values: ArrayLike) -> tuple[float, float, int]:
+    """Mean, standard error and count of per-realization values, their non-finite ones left out.
+
+    The standard error is std(ddof=1) / sqrt(count): the values must be
+    independent, one per realization (never the recorded times of one
+    trajectory).
+
+    Parameters
+    ----------
+    values : array_like, shape (R,)
+        One value per realization, in any unit; NaN for a realization that
+        has none.
+
+    Returns
+    -------
+    mean, sem : float
+        In the unit of ``values``; NaN without a finite value, and ``sem``
+        NaN with a single one.
+    count : int
+        The finite values used.
+
+    Examples
+    --------
+    >>> mean_sem([1.0, 3.0, np.nan])
+    (2.0, 1.0, 2)
+    """
+    a = np.asarray(values, dtype=np.float64)
     a = a[np.isfinite(a)]
     if a.size == 0:
-        return np.nan, np.nan
-    return float(a.mean()), float(a.std(ddof=1) / np.sqrt(a.size)) if a.size > 1 else np.nan
+        return math.nan, math.nan, 0
+    return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)) if a.size > 1 else math.nan, int(a.size)
 
 
 def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None) -> xr.Dataset:
@@ -108,9 +134,9 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     fitted = np.isfinite(slope)
     R = int(fitted.sum())
 
-    s_mean, s_sem = _mean_sem(slope)
-    a_mean, a_sem = _mean_sem(np.where(fitted, y[:, 0], np.nan))
-    b_mean, b_sem = _mean_sem(np.where(fitted, y[:, -1], np.nan))
+    s_mean, s_sem, _ = mean_sem(slope)
+    a_mean, a_sem, _ = mean_sem(np.where(fitted, y[:, 0], np.nan))
+    b_mean, b_sem, _ = mean_sem(np.where(fitted, y[:, -1], np.nan))
     units = values.attrs.get("units", "")
     out = xr.Dataset(
         {
@@ -271,17 +297,17 @@ def creep_law(x_G: xr.DataArray, *, t_max: float | None = None, factor: float = 
     v_late = (at[:, 2] - at[:, 1]) / (t3 - t2)
     R = int(usable.sum())
 
-    e_mean, e_sem = _mean_sem(v_early)
-    l_mean, l_sem = _mean_sem(v_late)
+    e_mean, e_sem, _ = mean_sem(v_early)
+    l_mean, l_sem, _ = mean_sem(v_late)
     ratio = l_mean / e_mean if e_mean != 0 else math.nan
     # Delta method: rho - rho_true ~ <v_late - rho v_early> / <v_early>, a mean of independent
     # per-realization terms; its spread keeps the covariance of v_early and v_late.
-    ratio_sem = _mean_sem((v_late - ratio * v_early) / e_mean)[1] if math.isfinite(ratio) else math.nan
+    ratio_sem = mean_sem((v_late - ratio * v_early) / e_mean)[1] if math.isfinite(ratio) else math.nan
     ratio_log = (math.log(t3 / t2) / (t3 - t2)) / (math.log(t2 / t1) / (t2 - t1))
 
     gaps = {}
     for name, predicted in (("steady", 1.0), ("log", ratio_log)):
-        g_mean, g_sem = _mean_sem(v_late - predicted * v_early)
+        g_mean, g_sem, _ = mean_sem(v_late - predicted * v_early)
         # Rounding is no evidence: exact synthetic laws have SE ~ 0 and a gap of a few ulps.
         rounding = 1e-12 * (abs(l_mean) + predicted * abs(e_mean))
         # NaN errors (one realization) compare False: no law is then called consistent.
