@@ -227,9 +227,9 @@ def child_lattice(size: int, steps: int, kind: str = "triangular") -> dict[str, 
 def child_irregular(n: int, steps: int, file: str) -> dict[str, Any]:
     """Rows 8 and 9: one realization of an irregular network of n nodes, also written to ``file`` for network.c.
 
-    The file (untimed, before the realization) holds the network's node
-    positions (l0) and springs in network.c's text format, so that both
-    programs solve the same network.
+    The file (untimed, before the realization; written by the first repeat)
+    holds the network's node positions (l0) and springs in network.c's text
+    format, so that both programs solve the same network.
     """
     import numpy as np
 
@@ -241,10 +241,12 @@ def child_irregular(n: int, steps: int, file: str) -> dict[str, Any]:
     scene = Scene.from_config(load_config(_irregular_config(n, steps)))
     t1 = time.perf_counter()
     net = scene.network
-    with open(file, "w") as fh:
-        fh.write(f"{net.n_nodes} {net.n_edges}\n")
-        np.savetxt(fh, net.positions, fmt="%.17g")
-        np.savetxt(fh, net.edges, fmt="%d")
+    # The same network at every repeat (network seed 0): written once, read by every C run.
+    if not os.path.exists(file):
+        with open(file, "w") as fh:
+            fh.write(f"{net.n_nodes} {net.n_edges}\n")
+            np.savetxt(fh, net.positions, fmt="%.17g")
+            np.savetxt(fh, net.edges, fmt="%d")
     t2 = time.perf_counter()
     real = Realization(scene, np.random.SeedSequence(1))
     t3 = time.perf_counter()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 import math
 import sys
 from pathlib import Path
@@ -34,6 +35,16 @@ def load_example(name: str) -> ModuleType:
 def assert_png(path: Path) -> None:
     assert path.is_file(), path
     assert path.read_bytes()[:8] == PNG_MAGIC, path
+
+
+def run_quick_study(name: str, out: Path) -> tuple[ModuleType, dict]:
+    """Run a study's --quick preset into ``out``: its module and its JSON summary, once the figure
+    is there and no temporary file is left behind."""
+    study = load_example(name)
+    assert study.main(["--quick", "--out", str(out)]) == 0
+    assert_png(out / f"{name}.png")
+    assert not list(out.glob(".*.tmp")), "a temporary file was left behind"
+    return study, json.loads((out / f"{name}.json").read_text())
 
 
 @pytest.mark.parametrize("name", ["creep_irregular", "chain_aging", "aging_networks", "creep_networks"], ids=str)
@@ -101,8 +112,6 @@ def test_chain_aging_quick(tmp_path):
 
 def test_incline_creep_quick(tmp_path):
     """The --quick preset (seeds fixed in the script): every chain follows its exact orbit; no creep below A_c."""
-    import json
-
     import numpy as np
 
     example = load_example("incline_creep")
@@ -126,13 +135,7 @@ def test_incline_creep_quick(tmp_path):
 
 def test_aging_networks_quick(tmp_path):
     """The --quick preset (chains of 2 and 4, irregular 16; 4 realizations, seed 1; ~10 s): numbers with errors."""
-    import json
-
-    study = load_example("aging_networks")
-    assert study.main(["--quick", "--out", str(tmp_path)]) == 0
-    assert_png(tmp_path / "aging_networks.png")
-    assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
-    data = json.loads((tmp_path / "aging_networks.json").read_text())
+    study, data = run_quick_study("aging_networks", tmp_path)
     preset = study.PRESETS["quick"]
     assert len(data["points"]) == sum(len(g.sizes) * len(g.stds) for g in preset.groups)
     for p in data["points"]:
@@ -162,13 +165,7 @@ def test_aging_networks_quick(tmp_path):
 def test_creep_networks_quick(tmp_path):
     """The --quick preset (chains of 2 and 4 to 1e3 tau_th, irregular 16 to 300; 8 realizations, seed 1;
     a few seconds): every point creeps downhill, steadily, with its numbers and errors."""
-    import json
-
-    study = load_example("creep_networks")
-    assert study.main(["--quick", "--out", str(tmp_path)]) == 0
-    assert_png(tmp_path / "creep_networks.png")
-    assert not list(tmp_path.glob(".*.tmp")), "a temporary file was left behind"
-    data = json.loads((tmp_path / "creep_networks.json").read_text())
+    study, data = run_quick_study("creep_networks", tmp_path)
     preset = study.PRESETS["quick"]
     assert [(p["kind"], p["n"]) for p in data["points"]] == [(g.kind, n) for g in preset.groups for n in g.sizes]
     assert data["parameters"]["f_ext_over_mu_d"] == 0.6

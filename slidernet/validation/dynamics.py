@@ -246,7 +246,6 @@ class Dynamics:
         thetas, draws = realization_draws(scene, seed_seq)
         return _Realization(self, thetas, draws).run(int(steps), bool(states))
 
-
     def tilt_test(self, u: np.ndarray, mu_s: np.ndarray, rng: np.random.Generator, *, theta: float = 0.0,
                   rate: float = TILT_RATE) -> dict[str, float]:
         """The dynamic tilt test: raise a uniform tilt on a state under the equations of motion until it slides.
