@@ -1,6 +1,6 @@
 """Seconds per network tilt test against network size, irregular networks and triangular lattices, one core.
 
-    python benchmarks/tilt_cost.py [--sizes 100 1000 10000] [--lattices 10 32] [--realizations 4]
+    python benchmarks/tilt_cost.py [--sizes 100 1000 10000] [--lattices 10 32] [--realizations 8]
                                    [--tests 2] [--age 3] [--seed 1] [--core 0] [--max-avalanche S]
                                    [--csv PATH] [--quick]
 
@@ -37,8 +37,13 @@ the tests of one realization are not (same state). The figures:
   (one per slip, read from the public ``Realization.buffers`` and
   ``Realization.state["tilt_mu_pos"]``), plus the slip that sets the network
   sliding, which draws none; per node as well;
-* the slip rate of the test (slips per test / seconds per test, per
-  realization): below the test's own rate where reruns were paid;
+* the slip rate of the tests (slips / seconds, per realization), apart for
+  the tests that did not refill the draw buffers (the test's own rate) and
+  for those that did (they ran again from the start at least once; the
+  slips counted are those of the run that slid), with the share of tests
+  that refilled. The scenes record no ``mu_eff``, so a realization's tilt
+  buffers start empty and its first test refills at its first slip (one
+  slip of work lost), then again each time it outgrows them;
 * the seconds of one thermal step of the same realizations and the ratio
   test / step (per realization, then averaged);
 * mu_eff, the test's result, for reference.
@@ -54,8 +59,8 @@ The process is pinned to one core (``--core``, default 0) with
 first, untimed. A test that does not reach sliding (``TiltTestError``, after
 ``solver.max_avalanche`` slips: 1e8 by default, ``--max-avalanche`` changes
 it) is counted and timed, and left out of the means. ``--quick`` is a smoke
-run of a few seconds (irregular 100 and 1000 nodes, lattice 10 x 10, one
-test each, age 2). ``--csv PATH`` writes one line per size with the numbers
+run of a few seconds (irregular 100 and 1000 nodes, lattice 10 x 10, 4
+realizations of one test each, age 2). ``--csv PATH`` writes one line per size with the numbers
 unformatted.
 """
 
@@ -83,7 +88,8 @@ NTILDE = 1e-7
 SIGMA_THETA = 1e-7
 
 #: Per-realization figures averaged over realizations, in table order: (key, CSV/label name).
-FIGURES = ("test_s", "test_us_per_node", "slips", "slips_per_node", "rate", "step_s", "test_per_step", "mu_eff")
+FIGURES = ("test_s", "test_us_per_node", "slips", "slips_per_node", "rate_plain", "rate_refilled", "refilled",
+           "step_s", "test_per_step", "mu_eff")
 
 
 def network_table(kind: str, size: int) -> dict[str, Any]:
@@ -158,7 +164,9 @@ def timed_test(real: Realization) -> dict[str, Any]:
     -------
     dict
         ``seconds`` (wall), ``cpu`` (process CPU seconds), ``mu_eff`` (NaN if
-        the test did not reach sliding), ``slips`` (0 then) and ``slid``.
+        the test did not reach sliding), ``slips`` (0 then), ``slid`` and
+        ``refilled`` (the test ran out of tilt draws at least once, so ran
+        again from the start; always True for a test that did not slide).
 
     Notes
     -----
@@ -174,11 +182,18 @@ def timed_test(real: Realization) -> dict[str, Any]:
         mu_eff = real.tilt_test()
     except TiltTestError:
         seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
-        return {"seconds": seconds, "cpu": cpu, "mu_eff": math.nan, "slips": 0, "slid": False}
+        return {"seconds": seconds, "cpu": cpu, "mu_eff": math.nan, "slips": 0, "slid": False, "refilled": True}
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     buf1, pos1 = _tilt_read(real)
-    read = pos1 - pos0 if buf1 is buf0 else pos1
-    return {"seconds": seconds, "cpu": cpu, "mu_eff": mu_eff, "slips": read + 1, "slid": True}
+    refilled = buf1 is not buf0  # a refill gives a new buffer, read from 0
+    read = pos1 if refilled else pos1 - pos0
+    return {"seconds": seconds, "cpu": cpu, "mu_eff": mu_eff, "slips": read + 1, "slid": True,
+            "refilled": refilled}
+
+
+def _rate(done: list[dict[str, Any]]) -> float:
+    """Slips per second over the tests ``done`` (NaN without any)."""
+    return sum(d["slips"] for d in done) / sum(d["seconds"] for d in done) if done else math.nan
 
 
 def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed: int,
@@ -236,15 +251,13 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
         b = real.buffers
         buffer_MB = max(buffer_MB, (b.tilt_mu.nbytes + b.tilt_u.nbytes) / 1e6)
         step_s = float(np.mean(steps))
-        if slid:
-            test_s = float(np.mean([d["seconds"] for d in slid]))
-            slips = float(np.mean([d["slips"] for d in slid]))
-            mu_eff = float(np.mean([d["mu_eff"] for d in slid]))
-        else:
-            test_s = slips = mu_eff = math.nan
+        test_s, slips, mu_eff = (float(np.mean([d[k] for d in slid])) if slid else math.nan
+                                 for k in ("seconds", "slips", "mu_eff"))
         values = {"test_s": test_s, "test_us_per_node": test_s / N * 1e6, "slips": slips,
-                  "slips_per_node": slips / N, "rate": slips / test_s, "step_s": step_s,
-                  "test_per_step": test_s / step_s, "mu_eff": mu_eff}
+                  "slips_per_node": slips / N, "rate_plain": _rate([d for d in slid if not d["refilled"]]),
+                  "rate_refilled": _rate([d for d in slid if d["refilled"]]),
+                  "refilled": float(np.mean([d["refilled"] for d in slid])) if slid else math.nan,
+                  "step_s": step_s, "test_per_step": test_s / step_s, "mu_eff": mu_eff}
         for k in FIGURES:
             per[k].append(values[k])
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6  # kB on Linux
@@ -265,15 +278,14 @@ def summary(row: dict[str, Any]) -> dict[str, float]:
     Returns
     -------
     dict
-        ``<figure>`` and ``<figure>_sem`` for each figure, and ``n_used``:
-        the realizations with a test that slid.
+        ``<figure>``, ``<figure>_sem`` and ``<figure>_n`` (the realizations
+        with a value: for the rates, those with such a test) for each figure,
+        and ``n_used``: the realizations with a test that slid.
     """
     out: dict[str, float] = {}
     for k in FIGURES:
-        m, s, n = mean_sem(row["per_realization"][k])
-        out[k], out[f"{k}_sem"] = m, s
-        if k == "test_s":
-            out["n_used"] = n
+        out[k], out[f"{k}_sem"], out[f"{k}_n"] = mean_sem(row["per_realization"][k])
+    out["n_used"] = out["test_s_n"]
     return out
 
 
@@ -337,13 +349,25 @@ def _pm(m: float, s: float) -> str:
     return f"({text})e{scale}" if scale else text
 
 
+def _share(m: float, s: float) -> str:
+    """A share in [0, 1], as ``m ± s`` or with two decimals where every realization gave the same."""
+    return f"{m:.2f}" if not math.isnan(m) and (math.isnan(s) or s == 0) else _pm(m, s)
+
+
 def _label(row: dict[str, Any]) -> str:
     return "irregular" if row["kind"] == "irregular" else f"triangular {row['size']} x {row['size']}"
 
 
 COLUMNS = ("network", "N", "realizations x tests", "s per test", "µs per test per node", "slips per test",
-           "slips per test per node", "M slips/s in the test", "s per thermal step", "test / thermal step",
-           "mu_eff", "did not slide")
+           "slips per test per node", "M slips/s: tests without a refill", "M slips/s: tests with a refill",
+           "tests with a refill", "s per thermal step", "test / thermal step", "mu_eff", "did not slide")
+
+
+def _rates(s: dict[str, float], key: str, realizations: int) -> str:
+    """A rate in M slips/s, with the realizations it rests on where some had no such test."""
+    text = _pm(s[key] / 1e6, s[f"{key}_sem"] / 1e6)
+    n = s[f"{key}_n"]
+    return text if n in (0, realizations) else f"{text} ({n} of {realizations})"
 
 
 def markdown(rows: list[dict[str, Any]]) -> str:
@@ -365,7 +389,8 @@ def markdown(rows: list[dict[str, Any]]) -> str:
             _label(row), f"{row['N']:,}", f"{row['realizations']} x {row['tests']}",
             _pm(s["test_s"], s["test_s_sem"]), _pm(s["test_us_per_node"], s["test_us_per_node_sem"]),
             _pm(s["slips"], s["slips_sem"]), _pm(s["slips_per_node"], s["slips_per_node_sem"]),
-            _pm(s["rate"] / 1e6, s["rate_sem"] / 1e6), _pm(s["step_s"], s["step_s_sem"]),
+            _rates(s, "rate_plain", row["realizations"]), _rates(s, "rate_refilled", row["realizations"]),
+            _share(s["refilled"], s["refilled_sem"]), _pm(s["step_s"], s["step_s_sem"]),
             _pm(s["test_per_step"], s["test_per_step_sem"]), _pm(s["mu_eff"], s["mu_eff_sem"]),
             f"{row['failed']} ({row['failed_s']:.0f} s)" if row["failed"] else "0",
         ]
@@ -444,7 +469,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="nodes of the irregular networks (default 100 1000 10000; --quick: 100 1000)")
     ap.add_argument("--lattices", type=int, nargs="*", default=None,
                     help="sides L of the triangular L x L lattices (default 10 32; --quick: 10)")
-    ap.add_argument("--realizations", type=int, default=4, help="independent realizations per size (default 4)")
+    ap.add_argument("--realizations", type=int, default=None,
+                    help="independent realizations per size (default 8; --quick: 4)")
     ap.add_argument("--tests", type=int, default=None, help="tilt tests per realization (default 2; --quick: 1)")
     ap.add_argument("--age", type=int, default=None,
                     help="thermal steps before the tests, at least 2 (default 3; --quick: 2)")
@@ -459,8 +485,9 @@ def main(argv: list[str] | None = None) -> int:
     sizes = sorted(args.sizes if args.sizes is not None else ([100, 1000] if q else [100, 1000, 10_000]))
     lattices = sorted(args.lattices if args.lattices is not None else ([10] if q else [10, 32]))
     tests = args.tests or (1 if q else 2)
+    realizations = args.realizations or (4 if q else 8)
     age = args.age or (2 if q else 3)
-    if age < 2 or tests < 1 or args.realizations < 1:
+    if age < 2 or tests < 1 or realizations < 1:
         ap.error("--age must be at least 2, --tests and --realizations at least 1")
 
     core = _pick_core(args.core)
@@ -470,7 +497,7 @@ def main(argv: list[str] | None = None) -> int:
     warm_up()
     rows = []
     for kind, size in [("irregular", n) for n in sizes] + [("triangular", L) for L in lattices]:
-        row = measure(kind, size, args.realizations, tests, age, args.seed, args.max_avalanche)
+        row = measure(kind, size, realizations, tests, age, args.seed, args.max_avalanche)
         rows.append(row)
         s = summary(row)
         print(f"  {_label(row)}, N = {row['N']:,}: {_pm(s['test_s'], s['test_s_sem'])} s per test, "
