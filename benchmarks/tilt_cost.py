@@ -48,6 +48,14 @@ the tests of one realization are not (same state). The figures:
   test / step (per realization, then averaged);
 * mu_eff, the test's result, for reference.
 
+Before the table, a line per size gives the fewest and most slips per test
+over the realizations (each a realization's mean), the largest ratio of
+the most to the fewest slips among the tests of one realization, the
+scene's setup time, the largest tilt draw buffers of a realization after
+its tests (``Realization.buffers``: thresholds and uniforms), the process's
+peak resident memory so far and the CPU share of the tests (CPU over wall
+seconds; below 1 where another process took the core).
+
 Below the table: for each kind of network with two sizes or more, the
 exponents alpha of cost ~ N^alpha (seconds per test and slips per test),
 between consecutive sizes (error propagated from the two standard errors)
@@ -221,7 +229,9 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
     -------
     dict
         ``N``, ``per_realization`` (a dict of arrays, one value per
-        realization, NaN where no test of it slid), ``failed`` (tests that did
+        realization, NaN where no test of it slid), ``within`` (the largest
+        ratio of the most to the fewest slips among the tests of one
+        realization; 0 with fewer than two tests), ``failed`` (tests that did
         not reach sliding) and ``failed_s`` (their seconds), ``tests``,
         ``cpu_share`` (CPU over wall seconds of all the tests), ``setup_s``
         (building the scene), ``buffer_MB`` (the largest tilt draw buffers of
@@ -233,7 +243,7 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
     setup = time.perf_counter() - t0
     N = scene.network.n_nodes
     per: dict[str, list[float]] = {k: [] for k in FIGURES}
-    failed, failed_s, wall, cpu, buffer_MB = 0, 0.0, 0.0, 0.0, 0.0
+    failed, failed_s, wall, cpu, buffer_MB, within = 0, 0.0, 0.0, 0.0, 0.0, 0.0
     for ss in np.random.SeedSequence(seed).spawn(realizations):
         real = Realization(scene, ss)
         real.advance(1)
@@ -248,6 +258,8 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
         slid = [d for d in done if d["slid"]]
         failed += len(done) - len(slid)
         failed_s += sum(d["seconds"] for d in done if not d["slid"])
+        if len(slid) > 1:
+            within = max(within, max(d["slips"] for d in slid) / min(d["slips"] for d in slid))
         b = real.buffers
         buffer_MB = max(buffer_MB, (b.tilt_mu.nbytes + b.tilt_u.nbytes) / 1e6)
         step_s = float(np.mean(steps))
@@ -262,7 +274,7 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
             per[k].append(values[k])
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6  # kB on Linux
     return {"kind": kind, "size": size, "N": N, "realizations": realizations, "tests": tests,
-            "per_realization": {k: np.array(v) for k, v in per.items()}, "failed": failed,
+            "per_realization": {k: np.array(v) for k, v in per.items()}, "within": within, "failed": failed,
             "failed_s": failed_s, "cpu_share": cpu / wall if wall > 0 else math.nan, "setup_s": setup,
             "buffer_MB": buffer_MB, "peak_GB": peak}
 
@@ -442,8 +454,9 @@ def write_csv(rows: list[dict[str, Any]], path: Path) -> None:
     """
     path.parent.mkdir(parents=True, exist_ok=True)
     keys = ("kind", "size", "N", "realizations", "tests", "failed", "failed_s", "cpu_share", "setup_s",
-            "buffer_MB", "peak_GB")
-    lines = [{**{k: r[k] for k in keys}, **summary(r)} for r in rows]
+            "buffer_MB", "peak_GB", "within")
+    lines = [{**{k: r[k] for k in keys}, "slips_min": np.nanmin(r["per_realization"]["slips"], initial=np.inf),
+              "slips_max": np.nanmax(r["per_realization"]["slips"], initial=-np.inf), **summary(r)} for r in rows]
     with path.open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(lines[0]))
         w.writeheader()
@@ -460,6 +473,16 @@ def _pick_core(core: int) -> int | None:
         core = allowed[-1]
     os.sched_setaffinity(0, {core})
     return core
+
+
+def _spread(row: dict[str, Any]) -> str:
+    """The fewest and most slips per test over the realizations, and the spread within one."""
+    v = row["per_realization"]["slips"]
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return "none slid"
+    text = f"{v.min():.3g} to {v.max():.3g}"
+    return text + (f"; within one, at most {row['within']:.2f} x" if row["within"] else "")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -501,7 +524,8 @@ def main(argv: list[str] | None = None) -> int:
         rows.append(row)
         s = summary(row)
         print(f"  {_label(row)}, N = {row['N']:,}: {_pm(s['test_s'], s['test_s_sem'])} s per test, "
-              f"{_pm(s['slips'], s['slips_sem'])} slips; did not slide: {row['failed']}; setup "
+              f"{_pm(s['slips'], s['slips_sem'])} slips (by realization {_spread(row)}); did not slide: "
+              f"{row['failed']}; setup "
               f"{row['setup_s']:.2f} s; tilt draw buffers up to {row['buffer_MB']:.0f} MB; peak resident "
               f"{row['peak_GB']:.2f} GB; CPU share {row['cpu_share']:.2f}", flush=True)
 
