@@ -426,3 +426,23 @@ def test_realization_draws_follow_the_documented_streams():
                                   real.scene.driver.thetas(rngs["driver"], 10) / real.scene.network.Ntilde)
     np.testing.assert_array_equal(real.mu, dist.sample(rngs["thresholds"], 2))
     np.testing.assert_array_equal(real.buffers.mu, dist.sample(rngs["thresholds"], 32))
+
+
+@pytest.mark.parametrize("index", [3, (3,), (1, 3)], ids=["row", "tuple-1d", "tuple-2d"])
+def test_prefetch_compiles_and_changes_no_value(index):
+    # A hint only: the values read after it are those before it, and an index past the end is harmless.
+    from numba import njit
+
+    from slidernet.kernels.memory import prefetch
+
+    arr = np.arange(12.0).reshape(2, 6) if len(np.atleast_1d(index)) == 2 else np.arange(6.0)
+
+    @njit
+    def touch(a, i):
+        prefetch(a, i)
+        return a.sum()
+
+    assert touch(arr, index) == arr.sum()
+    if isinstance(index, int):
+        assert touch(arr, 10_000) == arr.sum()
+    np.testing.assert_array_equal(arr, np.arange(arr.size, dtype=float).reshape(arr.shape))
