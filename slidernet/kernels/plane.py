@@ -265,13 +265,11 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
     budget. Used by the kernel and by the network tilt test.
     """
     fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
-    # The diagonal block K_ii by node: at a driving event (a random node) diag[i] and then the
-    # table's block were two cache misses in a row, 13 % of the kernel's time at 1e6 nodes
-    # (perf, irregular network).
-    K = net.K_ii
-    kxx = K[i, 0, 0]
-    kxy = K[i, 0, 1]
-    kyy = K[i, 1, 1]
+    b = block_of(net, net.diag[i])  # the diagonal block K_ii
+    K = net.K_table
+    kxx = K[b, 0, 0]
+    kxy = K[b, 0, 1]
+    kyy = K[b, 1, 1]
     if settings.slip_mode == SLIP_EXACT:
         dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
         return nsteps >= 0, dux, duy
@@ -317,18 +315,19 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
     st.y_G += duy * wi
     lo = net.indptr[i]
     hi = net.indptr[i + 1]
-    # Ask for every neighbour's lines first, so that their cache misses overlap: re-keying one
-    # neighbour is too long a chain for the processor to reach the next one's loads on its own.
-    r = heaps.active[0]
-    all_driven = heaps.leaf.size == 0
-    for p in range(lo, hi):
-        j = net.indices[p]
-        prefetch(nodes.a, j)
-        prefetch(net.g, j)
-        prefetch(nodes.mu, j)
-        prefetch(heaps.slot, j)
-        prefetch(heaps.stale, j)
-        if all_driven:
+    if heaps.leaf.size == 0:
+        # Every node is driven (an irregular network): driving events land anywhere, and each
+        # neighbour's lines are out of cache. Ask for all of them first, so that their misses
+        # overlap instead of waiting one neighbour's re-keying each (a lattice's activity stays at
+        # its driven boundary, in cache: nothing to gain there).
+        r = heaps.active[0]
+        for p in range(lo, hi):
+            j = net.indices[p]
+            prefetch(nodes.a, j)
+            prefetch(net.g, j)
+            prefetch(nodes.mu, j)
+            prefetch(heaps.slot, j)
+            prefetch(heaps.stale, j)
             prefetch(heaps.tkey, (r, j))
     for p in range(lo, hi):
         j = net.indices[p]

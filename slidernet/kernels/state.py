@@ -328,9 +328,6 @@ class Plane(NamedTuple):
     K_id: np.ndarray  # (nnzb,) int32: row of K_table holding the block
     K_table: np.ndarray  # (B, 2, 2) the distinct blocks of K, in k0
     diag: np.ndarray  # (N,) int64: position of K_ii in the row (indices, K_id)
-    # (N, 2, 2) K_ii itself, a copy of K_table[K_id[diag]] indexed by node: a slip reads its node's
-    # block in one load, not after two dependent ones (diag, then the table).
-    K_ii: np.ndarray
     g: np.ndarray  # (N, 2) thermal load
     normal_load: np.ndarray  # (N,)
     w: np.ndarray  # (N,)

@@ -80,10 +80,8 @@ def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: n
     indices = indices.astype(np.int32, copy=False)
     K_id = K_id.astype(np.int32, copy=False)
     per_entry = K_table.shape[0] == K_id.size and bool((K_id == np.arange(K_id.size)).all())
-    diag = diagonal_positions(indptr, indices)
     return Plane(indptr=indptr, indices=indices, K_id=K_id, K_table=K_table,
-                 diag=diag, K_ii=np.ascontiguousarray(K_table[K_id[diag]], dtype=np.float64), g=g,
-                 normal_load=normal_load, w=w, unit_load=unit_load,
+                 diag=diagonal_positions(indptr, indices), g=g, normal_load=normal_load, w=w, unit_load=unit_load,
                  block_per_entry=per_entry)
 
 
