@@ -1,12 +1,12 @@
 """Software prefetch for the kernels: ask for a cache line before the loop that needs it.
 
-At a million nodes a slip's neighbours sit in memory that no cache holds.
-The kernels used to wait for them one by one: re-keying a neighbour (its
-force, threshold, heap slot, stale mark and tree leaf, then a walk up the
-driving tree) is a chain of dependent work long enough that the processor
-could not reach the next neighbour's loads before the first ones came back.
-:func:`prefetch` issues those loads up front, so the misses of a whole row
-of K overlap; it changes no value.
+In an irregular network of a million nodes, a slip's neighbours (their
+forces, thermal loads, thresholds, heap slots, stale marks and tree leaves)
+sit in memory that no cache holds. :func:`prefetch` asks for all of them
+before the slip re-keys the first one, so that their misses can overlap; it
+changes no value. Measured on irregular networks (interleaved runs on one
+core, 2026-11-26): +1.7 to +29 % at 1e6 nodes (median +5.5 %), no change
+beyond the run-to-run spread at 1e4; the performance guide has the runs.
 """
 
 from __future__ import annotations
