@@ -13,10 +13,10 @@ random 8-byte loads over an array of that size:
   many loads in flight; the time per load is the memory's throughput for
   random reads.
 
-A 2D network's kernel state is about 430 bytes per node (positions of K's
-blocks, forces, thermal loads, thresholds, heap and tree entries), so a
-network of N nodes works on roughly 430 N bytes: 4.3 MB at 1e4 nodes, 430 MB
-at 1e6. Reading a row of the table against those sizes tells how far from
+A 2D irregular network's kernel state is about 420 bytes per node (K's
+blocks, one per entry, forces, thermal loads, thresholds, heap and tree
+entries; the performance guide), so a network of N nodes works on roughly
+420 N bytes: 4.2 MB at 1e4 nodes, 420 MB at 1e6. Reading a row of the table against those sizes tells how far from
 the cache each network runs on this machine. The numbers depend on the
 machine and on what else shares its last-level cache; the script prints the
 load average with them.
