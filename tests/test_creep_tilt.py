@@ -340,3 +340,46 @@ def test_a_damped_collective_motion_restarts_the_count_of_a_part_sliding_alone()
     r = Realization(Scene.from_config(load_config(cfg)), np.random.SeedSequence(1, spawn_key=(0,))).advance()
     samples = r.out["f_sum"] / r.out["f_count"]
     assert (r.out["f_count"] == 1).all() and (samples > 0.5).all()
+
+
+def _lattice_tilt_scene(batch: int, **solver) -> Scene:
+    cfg = {"seed": 3, "realizations": 1, "steps": 2, "record": "all", "observables": ["n", "mu_eff"],
+           "network": {"kind": "triangular", "shape": [8, 8], "Ntilde": 1e-7},
+           "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+           "driver": {"name": "gaussian_steps", "sigma_theta": 1e-7}, "solver": {"batch": batch, **solver}}
+    return Scene.from_config(load_config(cfg))
+
+
+@pytest.mark.parametrize("batch", [16, 100], ids=["batch-16", "batch-100"])
+def test_a_network_tilt_test_that_runs_out_of_draws_goes_on_where_it_stood(batch: int) -> None:
+    # A test of an 8 x 8 lattice takes hundreds of thresholds: with a batch of 16 or 100 it runs out several
+    # times. It must go on from where it stood (not start again): the same sample and the same draws as
+    # with buffers long enough, the threshold buffer grown to at most twice what the test read plus a
+    # batch, and the uniforms (read only by a pair's creep rule) not grown at all.
+    seed = np.random.SeedSequence(5)
+    ref = Realization(_lattice_tilt_scene(10**7), seed)
+    ref.advance(1)  # with a test at steps 0 and 1 (the records)
+    ref_start = int(ref.state["tilt_mu_pos"][0])
+    f_ref = ref.tilt_test()
+    used = int(ref.state["tilt_mu_pos"][0]) - ref_start
+    assert used > 5 * batch  # the case needs several refills
+
+    r = Realization(_lattice_tilt_scene(batch), seed)
+    r.advance(1)
+    assert r.tilt_test() == f_ref
+    buffers = r.streams.buffers
+    assert buffers.tilt_mu.size <= 2 * (used + batch)
+    assert buffers.tilt_u.size == batch
+    # The next draw is the reference's next one.
+    assert buffers.tilt_mu[r.state["tilt_mu_pos"][0]] == ref.streams.buffers.tilt_mu[ref_start + used]
+
+
+def test_a_tilt_test_stopped_by_max_avalanche_says_so() -> None:
+    # The test of an 8 x 8 lattice takes hundreds of slips; at solver.max_avalanche = 50 it gives up,
+    # and the message names that limit, not the rule of a part sliding alone below mu_d.
+    r = Realization(_lattice_tilt_scene(1000, max_avalanche=50), np.random.SeedSequence(5))
+    with pytest.raises(slidernet.TiltTestError,
+                       match=r"did not reach sliding at step 0: after 51 slips, at a load per unit normal load of "
+                             r"0\.[0-9]+, it reached solver\.max_avalanche = 50 slips in all\. A genuinely long "
+                             r"test needs a larger solver\.max_avalanche\."):
+        r.tilt_test()

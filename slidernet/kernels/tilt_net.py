@@ -63,13 +63,31 @@ from slidernet.kernels.state import TILT_NEED_DRAWS, TILT_TOO_LONG, kernel_jit
 P_MU = 0  # read position in the threshold buffer
 P_U = 1  # read position in the uniform buffer
 N_SLIPS = 2  # slips made by the test (out)
-N_POS = 3
+STAGE = 3  # 0: start a test; else where a test that ran out of draws resumes (R_REDRAW, R_CREEP)
+STOP = 4  # why the test gave up (out): STOP_SLIPS, STOP_PART, STOP_SLIP_MOTION; 0 otherwise
+# The test's counters, kept here when it returns for draws so that it can resume where it stood.
+S_NODE = 5  # the node whose threshold is to be redrawn
+S_EP = 6  # the current avalanche (see ``epoch``)
+S_MOVED = 7
+S_PENDING = 8
+S_AV = 9  # slips of the current avalanche (rule 4)
+N_POS = 10
+
+# Where a test that ran out of draws resumes (``pos[STAGE]``).
+R_REDRAW = 1  # redraw the threshold of node pos[S_NODE], which has just slipped
+R_CREEP = 2  # the appendix's creep rule (a 1D pair), which redraws both thresholds
+
+# Why a test gave up (``pos[STOP]``, with the result ``TILT_TOO_LONG``).
+STOP_SLIPS = 1  # settings.max_slips slips in all
+STOP_PART = 2  # an avalanche passed av_cap slips with the load at or below mu_d (rule 4)
+STOP_SLIP_MOTION = 3  # an exactly integrated slip did not come to rest within its step budget
 
 # Slots of the float array ``loads`` (shape (N_LOADS,)) the test fills, each a load per unit normal load
 # along x, f + f_bar, like the sample; NaN where the event did not happen before the test ended.
 L_FIRST = 0  # at the test's first slip (the first critical f)
 L_MOVING = 1  # when an avalanche first set every node in motion at once, whatever its relation to mu_d
-N_LOADS = 2
+L_F = 2  # the tilt f reached so far: where a test resumes, and the load of a test that gave up
+N_LOADS = 3
 
 # The test's two heaps.
 _UNSTABLE = 0  # unstable nodes keyed by overload
@@ -130,6 +148,7 @@ def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
     return p_mu + 2, p_u + 1
 
 
+
 @kernel_jit()
 def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
                       loads):
@@ -156,9 +175,11 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         Use the appendix's creep rule (a 1D pair of sliders).
     tilt_mu, tilt_u : ndarray
         Thresholds and uniforms of the tilt stream, read from ``pos[P_MU]``
-        and ``pos[P_U]``; the positions advance only if a sample is returned.
+        and ``pos[P_U]`` on.
     pos : ndarray of int64, shape (N_POS,)
-        Read positions (slots ``P_MU``, ``P_U``) and the slip count (``N_SLIPS``).
+        Read positions (slots ``P_MU``, ``P_U``), the slip count
+        (``N_SLIPS``), why a test gave up (``STOP``), and the test's stage
+        and counters: set ``pos[STAGE] = 0`` to start a test.
     av_cap : int
         Slips of one avalanche after which a part of the network is taken to
         slide on its own (rule 4).
@@ -172,31 +193,63 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         or not (``L_MOVING``; NaN if none did: a part slid alone). They
         tell what the sample rests on: the onset of the first slip, the
         collective motion, and the rule that only motion above mu_d slides.
+        ``L_F``: the tilt f reached so far.
 
     Returns
     -------
     float
-        f + f_bar when the network slides (a mu_eff sample), ``TILT_NEED_DRAWS``
-        if a buffer ran out, ``TILT_TOO_LONG`` after ``max_slips`` slips.
+        f + f_bar when the network slides (a mu_eff sample); ``TILT_TOO_LONG``
+        if the test gave up (``pos[STOP]`` says why); ``TILT_NEED_DRAWS`` if a
+        buffer ran out. The test then stands where it stopped, in ``G``,
+        ``mu``, ``heaps``, ``epoch``, ``loads`` and ``pos``: called again with
+        these, and with buffers that hold the same values from ``pos[P_MU]``
+        and ``pos[P_U]`` on and more after them, it goes on as if the buffers
+        had been long enough (the same draws in the same order: the same
+        sample).
     """
     N = mu.size
     normal_load = net.normal_load
     p_mu = pos[P_MU]
     p_u = pos[P_U]
-    heap_clear(heaps)
-    f = 0.0
-    loads[L_FIRST] = math.nan
-    loads[L_MOVING] = math.nan
-    for j in range(N):
-        _key(j, f, G, mu, normal_load, heaps)
-        epoch[j] = -1
-    ep = 0
-    slips = 0
-    # moved: nodes that slipped in the current avalanche; pending: unstable nodes that have not.
-    moved = 0
-    pending = heaps.size[_UNSTABLE]
-    av_slips = 0
+    stage = pos[STAGE]
+    if stage == 0:
+        heap_clear(heaps)
+        f = 0.0
+        loads[L_FIRST] = math.nan
+        loads[L_MOVING] = math.nan
+        for j in range(N):
+            _key(j, f, G, mu, normal_load, heaps)
+            epoch[j] = -1
+        ep = 0
+        slips = 0
+        # moved: nodes that slipped in the current avalanche; pending: unstable nodes that have not.
+        moved = 0
+        pending = heaps.size[_UNSTABLE]
+        av_slips = 0
+        i = -1
+    else:
+        f = loads[L_F]
+        i = pos[S_NODE]
+        ep = pos[S_EP]
+        slips = pos[N_SLIPS]
+        moved = pos[S_MOVED]
+        pending = pos[S_PENDING]
+        av_slips = pos[S_AV]
+    pos[STOP] = 0
     while True:
+        # What the last slip left to do, each step first checking that its draws are there:
+        # redraw the slipped node's threshold, or apply the pair's creep rule (both thresholds).
+        if stage == R_CREEP:
+            if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
+                return _wait_for_draws(pos, loads, R_CREEP, p_mu, p_u, f, i, ep, slips, moved, pending, av_slips)
+            p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
+        elif stage == R_REDRAW:
+            if p_mu + 1 > tilt_mu.size:
+                return _wait_for_draws(pos, loads, R_REDRAW, p_mu, p_u, f, i, ep, slips, moved, pending,
+                                       av_slips)
+            mu[i] = tilt_mu[p_mu]
+            p_mu += 1
+            _key(i, f, G, mu, normal_load, heaps)
         driving = heaps.size[_UNSTABLE] == 0
         if driving:
             # Raise f to the next critical value; a new avalanche starts.
@@ -215,14 +268,13 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         slips += 1
         av_slips += 1
         pos[N_SLIPS] = slips
+        loads[L_F] = f
         if slips > settings.max_slips:
-            return TILT_TOO_LONG
+            return _give_up(pos, STOP_SLIPS)
         if av_slips > av_cap:
             if f + f_bar > settings.mu_d:
-                pos[P_MU] = p_mu
-                pos[P_U] = p_u
-                return f + f_bar
-            return TILT_TOO_LONG
+                return _sample(pos, p_mu, p_u, f + f_bar)
+            return _give_up(pos, STOP_PART)
         if epoch[i] != ep:
             if heaps.slot[i, _UNSTABLE] >= 0:
                 pending -= 1
@@ -230,7 +282,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             moved += 1
         ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu)
         if not ok:
-            return TILT_TOO_LONG
+            return _give_up(pos, STOP_SLIP_MOTION)
         spread(net, G, i, dux, duy)
         for p in range(net.indptr[i], net.indptr[i + 1]):
             j = net.indices[p]
@@ -240,18 +292,15 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             now = _key(j, f, G, mu, normal_load, heaps)
             if epoch[j] != ep:
                 pending += int(now) - int(was)
+        stage = R_REDRAW
         if moved + pending == N:
             # Every node is in motion at once.
             if math.isnan(loads[L_MOVING]):
                 loads[L_MOVING] = f + f_bar
             if f + f_bar > settings.mu_d:
-                pos[P_MU] = p_mu
-                pos[P_U] = p_u
-                return f + f_bar
+                return _sample(pos, p_mu, p_u, f + f_bar)
             if pair_rule:
-                if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
-                    return TILT_NEED_DRAWS
-                p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
+                stage = R_CREEP
                 continue
             # Damped collective motion: the avalanche goes on, counted afresh
             # from the node that is moving now.
@@ -262,8 +311,36 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             # motion in a large network is not a part sliding alone.
             av_slips = 0
             pending = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
-        if p_mu + 1 > tilt_mu.size:
-            return TILT_NEED_DRAWS
-        mu[i] = tilt_mu[p_mu]
-        p_mu += 1
-        _key(i, f, G, mu, normal_load, heaps)
+
+
+@kernel_jit(inline="always")
+def _sample(pos, p_mu, p_u, load):
+    """End the test with a sample, the load f + f_bar: the read positions after its draws."""
+    pos[P_MU] = p_mu
+    pos[P_U] = p_u
+    pos[STAGE] = 0
+    return load
+
+
+@kernel_jit(inline="always")
+def _give_up(pos, why):
+    """End the test without a sample (``TILT_TOO_LONG``); ``why`` goes to ``pos[STOP]``."""
+    pos[STOP] = why
+    pos[STAGE] = 0
+    return TILT_TOO_LONG
+
+
+@kernel_jit(inline="always")
+def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moved, pending, av_slips):
+    """Keep where the test stands, to resume at ``stage`` once the buffers are longer."""
+    pos[P_MU] = p_mu
+    pos[P_U] = p_u
+    pos[STAGE] = stage
+    pos[S_NODE] = i
+    pos[S_EP] = ep
+    pos[N_SLIPS] = slips
+    pos[S_MOVED] = moved
+    pos[S_PENDING] = pending
+    pos[S_AV] = av_slips
+    loads[L_F] = f
+    return TILT_NEED_DRAWS

@@ -226,36 +226,55 @@ class Realization:
         f_ext along x. The state is left as it was; the draws come from the
         realization's tilt stream.
         """
-        from slidernet.kernels.tilt_net import N_LOADS, N_POS, N_SLIPS, P_MU, P_U, tilt_test_network
+        from slidernet.kernels import tilt_net
 
         scene = self.scene
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         if self._tilt_work is None:
-            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N_POS, np.int64),
-                               np.zeros(N_LOADS))
+            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64),
+                               np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS))
         heaps, epoch, pos, loads = self._tilt_work
         F = self.forces().reshape(N, -1)
+        G = np.zeros((N, 2))
+        G[:, : F.shape[1]] = F
+        mu = self.mu.copy()
         st = self.state
+        pos[:] = 0
+        pos[tilt_net.P_MU], pos[tilt_net.P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
+        settings = scene.settings()
+        cap = tilt_avalanche_cap(N)
         while True:
-            G = np.zeros((N, 2))
-            G[:, : F.shape[1]] = F
-            pos[P_MU], pos[P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
             buffers = self.buffers
-            f = tilt_test_network(G, self.mu.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
-                                  buffers.tilt_mu, buffers.tilt_u, pos, tilt_avalanche_cap(N), heaps, epoch, loads)
+            f = tilt_net.tilt_test_network(G, mu, o.f_ext, o.f_bar, o.net, settings, o.pair_rule, buffers.tilt_mu,
+                                           buffers.tilt_u, pos, cap, heaps, epoch, loads)
             status = kernels.tilt_status(f)
             if status == kernels.DONE:
-                st["tilt_mu_pos"], st["tilt_u_pos"] = pos[P_MU], pos[P_U]
+                st["tilt_mu_pos"], st["tilt_u_pos"] = pos[tilt_net.P_MU], pos[tilt_net.P_U]
                 return float(f)
             if status != kernels.NEED_TILT:
-                raise TiltTestError(
-                    f"The network tilt test did not reach sliding at step {self.step}: it made "
-                    f"{int(pos[N_SLIPS])} slips (at most solver.max_avalanche = {scene.max_avalanche} in all, "
-                    f"{tilt_avalanche_cap(N)} in one avalanche) with the load per unit normal load still "
-                    f"at or below mu_d."
-                )
-            self.streams.refill_tilt(self.state)
+                raise TiltTestError(self._tilt_stop_reason(pos, float(loads[tilt_net.L_F] + o.f_bar), cap))
+            # The test stands where it ran out: longer buffers, and it goes on from there.
+            pos[tilt_net.P_MU], pos[tilt_net.P_U] = self.streams.extend_tilt(
+                st, (int(pos[tilt_net.P_MU]), int(pos[tilt_net.P_U])))
+
+    def _tilt_stop_reason(self, pos: np.ndarray, load: float, cap: int) -> str:
+        """The message of a network tilt test that gave up (``pos[STOP]`` of the kernel says why)."""
+        from slidernet.kernels import tilt_net
+
+        scene = self.scene
+        slips = int(pos[tilt_net.N_SLIPS])
+        head = (f"The network tilt test did not reach sliding at step {self.step}: after {slips} slips, at a load "
+                f"per unit normal load of {load!r}, ")
+        why = int(pos[tilt_net.STOP])
+        if why == tilt_net.STOP_SLIPS:
+            return head + (f"it reached solver.max_avalanche = {scene.max_avalanche} slips in all. A genuinely "
+                           "long test needs a larger solver.max_avalanche.")
+        if why == tilt_net.STOP_PART:
+            return head + (f"one avalanche passed {cap} slips without setting every node in motion, with the load "
+                           f"still at or below mu_d = {scene.mu_d!r}: a part of the network creeps on its own.")
+        return head + ("a slip of the exactly integrated 2D motion (solver.slip = 'exact') did not come to rest "
+                       "within its step budget.")
 
     def refill(self, status: int) -> bool:
         """Top up the draw buffer a kernel's ``status`` says ran out; False for any other status.

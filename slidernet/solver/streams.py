@@ -208,15 +208,17 @@ class Streams:
         return False
 
     def refill_tilt(self, state: np.ndarray) -> None:
-        """Top up the tilt test's buffers after a test ran out of one of them.
+        """Top up the tilt test's buffers after a pair's tilt test ran out of one of them.
 
-        The thresholds come from the tilt stream, the uniforms from
-        ``rngs["tilt_uniforms"]`` (``random()`` takes one 64-bit word per
-        value, so how it is cut into calls changes nothing). Each kind is
-        thus read in an order set by the seed alone, and this rule only
-        decides how many values wait in the buffers: a buffer with fewer than
-        ``batch`` unread draws gets a batch. If both still held a batch, one
-        test needed more than that (a long avalanche): both grow, so that the
+        The pair's test (inside its kernel) starts again from its first draw
+        after a refill; a network's test goes on where it stood
+        (:meth:`extend_tilt`). The thresholds come from the tilt stream, the
+        uniforms from ``rngs["tilt_uniforms"]`` (``random()`` takes one 64-bit
+        word per value, so how it is cut into calls changes nothing). Each
+        kind is thus read in an order set by the seed alone, and this rule
+        only decides how many values wait in the buffers: a buffer with fewer
+        than ``batch`` unread draws gets a batch. If both still held a batch,
+        one test needed more than that (a long creep): both grow, so that the
         retry gets further.
         """
         batch, st, buf = self.scene.batch, state[0], self.buffers
@@ -229,6 +231,37 @@ class Streams:
         )
         state["tilt_mu_pos"] = 0
         state["tilt_u_pos"] = 0
+
+    def extend_tilt(self, state: np.ndarray, reading: tuple[int, int]) -> tuple[int, int]:
+        """Lengthen the tilt buffers under a network tilt test that ran out of draws; its new read positions.
+
+        The test has read the buffers from the realization's positions
+        (``state``'s ``tilt_mu_pos``, ``tilt_u_pos``) up to ``reading`` =
+        (p_mu, p_u), and goes on from there
+        (:func:`slidernet.kernels.tilt_net.tilt_test_network`). The values it
+        has read stay in the buffers until it ends, so that a test stopped
+        half-way is made again from the same draws. A buffer with fewer than
+        ``batch`` values after its reading position gets as many new draws as
+        it holds from the realization's position on, and at least a batch:
+        doubling keeps the returns of a long test logarithmic in its length,
+        and only the buffer that ran out grows (the uniforms are read by the
+        pair's creep rule alone). Values read before the realization's
+        position are dropped, both positions moving back with them.
+        """
+        batch, st, buf = self.scene.batch, state[0], self.buffers
+        grown = {}
+        new_reading = []
+        for name, stream, key, at in (("tilt_mu", self.truncated["tilt"].take, "tilt_mu_pos", reading[0]),
+                                      ("tilt_u", self.rngs["tilt_uniforms"].random, "tilt_u_pos", reading[1])):
+            values, start = getattr(buf, name), int(st[key])
+            if values.size - at < batch:
+                kept = values[start:]
+                grown[name] = np.concatenate([kept, stream(max(batch, kept.size))])
+                state[key] = 0
+                at -= start
+            new_reading.append(int(at))
+        self.buffers = buf._replace(**grown)
+        return new_reading[0], new_reading[1]
 
     def snapshot(self) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
         """The streams' state: JSON values (``rngs``: each Generator's ``bit_generator.state``) and arrays
