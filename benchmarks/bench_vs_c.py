@@ -2,6 +2,7 @@
 
     python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--repeat 3] [--sizes L ...] [--core 1]
                                     [--csv PATH] [--no-delaunay] [--paper]
+                                    [--rows {pair,workers,lattices,irregular} ...]
 
 The yardsticks are plain C programs that solve the same model the
 straightforward way, on one core: ``twoslider_loop.c`` (the paper's two
@@ -75,7 +76,9 @@ a second or two moves by several per cent on a shared machine.
 
 ``--quick`` is a smoke run (10 000 steps for two sliders, 200 steps at
 32 x 32, ``--sizes 100``): its ratios are noisy. ``--csv PATH`` writes one
-line per row, with the numbers unformatted.
+line per row, with the numbers unformatted. ``--rows`` runs some groups of
+rows alone: ``pair`` (1 and 2), ``workers`` (3), ``lattices`` (4 to 7),
+``irregular`` (8 and 9).
 """
 
 from __future__ import annotations
@@ -104,6 +107,8 @@ SMALL = 32  # the ~1e3-node lattice of rows 4 and 6
 # 7e7 slips (every node is driven: about 20 N slips a step at sigma_theta / Ntilde = 1).
 IRREGULAR = ((10_000, 400), (1_000_000, 6))
 IRREGULAR_Q = ((1_000, 100), (10_000, 10))
+# --rows: groups of rows that can run alone.
+ROW_GROUPS = ("pair", "workers", "lattices", "irregular")
 
 
 # ---------------------------------------------------------------------------
@@ -498,6 +503,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="runs of rows 1 to 5, alternating slidernet and C, reported as medians (default 3)")
     ap.add_argument("--paper", action="store_true",
                     help="also time `slidernet paper` (full preset, all cores; minutes)")
+    ap.add_argument("--rows", nargs="+", choices=ROW_GROUPS, default=list(ROW_GROUPS),
+                    help="the groups of rows to run: pair (rows 1 and 2), workers (3), lattices (4 to 7), "
+                         "irregular (8 and 9); default all")
     ap.add_argument("--child", nargs=2, metavar=("NAME", "JSON"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -506,6 +514,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
 
     q = args.quick
+    rows = set(args.rows)
     pair_steps, small_steps, big_steps = (10_000, 200, 20) if q else (100_000, 2000, 20)
     # Row 3 runs 10 times row 1's steps: at 1e5 steps its 20 realizations took 0.9 s on one
     # worker, where the pool's fixed cost (about 40 ms) and the last realization's tail
@@ -528,99 +537,105 @@ def main(argv: list[str] | None = None) -> int:
 
         n = max(1, args.repeat)
 
-        # 1. two sliders, one core
-        ours, theirs, r_ours, r_theirs = repeated(
-            n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": False}, core),
-            (lambda: c_pair(exe["twoslider_loop"], pair_steps, realizations, core)) if exe else None)
-        shares += [ours["cpu_share"]] + ([theirs["cpu_share"]] if theirs else [])
-        table.add(f"two sliders, {realizations} x {pair_steps:,} steps, one core", "M/s", ours["rate"],
-                  theirs and theirs["rate"], target=">= 1.2", slips=(ours["slips"], theirs and theirs["slips"]),
-                  mu=(ours["mean_mu"], theirs and theirs["mean_mu"]),
-                  ours_text=f"{ours['rate'] / 1e6:.2f} M/s{_spread(r_ours, r_theirs)}")
+        if "pair" in rows:
+            # 1. two sliders, one core
+            ours, theirs, r_ours, r_theirs = repeated(
+                n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": False},
+                                     core),
+                (lambda: c_pair(exe["twoslider_loop"], pair_steps, realizations, core)) if exe else None)
+            shares += [ours["cpu_share"]] + ([theirs["cpu_share"]] if theirs else [])
+            table.add(f"two sliders, {realizations} x {pair_steps:,} steps, one core", "M/s", ours["rate"],
+                      theirs and theirs["rate"], target=">= 1.2",
+                      slips=(ours["slips"], theirs and theirs["slips"]),
+                      mu=(ours["mean_mu"], theirs and theirs["mean_mu"]),
+                      ours_text=f"{ours['rate'] / 1e6:.2f} M/s{_spread(r_ours, r_theirs)}")
 
-        # 2. with the tilt test
-        tilt, _, r_tilt, _ = repeated(
-            n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": True}, core),
-            None)
-        shares.append(tilt["cpu_share"])
-        table.add("two sliders + tilt test (mu_eff), one core", "M/s", tilt["rate"], c_applies=False,
-                  target=">= 20 M/s", slips=(tilt["slips"], None),
-                  mu=(tilt["mean_mu"], None), ours_text=f"{tilt['rate'] / 1e6:.2f} M/s{_spread(r_tilt, [])}")
+            # 2. with the tilt test
+            tilt, _, r_tilt, _ = repeated(
+                n, lambda: run_child("pair", {"steps": pair_steps, "realizations": realizations, "tilt": True},
+                                     core),
+                None)
+            shares.append(tilt["cpu_share"])
+            table.add("two sliders + tilt test (mu_eff), one core", "M/s", tilt["rate"], c_applies=False,
+                      target=">= 20 M/s", slips=(tilt["slips"], None),
+                      mu=(tilt["mean_mu"], None), ours_text=f"{tilt['rate'] / 1e6:.2f} M/s{_spread(r_tilt, [])}")
 
-        # 3. 2 workers against 1 (slidernet.run, execution.workers); a speed-up per run, its median
-        runs = []
-        for _ in range(n):
-            ens = run_child("workers", {"steps": ens_steps, "realizations": ens_realizations, "workers": 2},
-                            None)
-            one, two = ens["1"], ens["2"]
-            if one["slips"] != two["slips"]:
-                raise AssertionError(f"slidernet.run: {one['slips']} slips on 1 worker, {two['slips']} on 2")
-            runs.append({"rate": two["rate"] / one["rate"], "one": one["rate"], "two": two["rate"],
-                         "share_one": one["cpu_share"], "share_two": two["cpu_share"], "slips": two["slips"]})
-        ens = _median(runs)
-        by_run = ", ".join(f"{r['rate']:.2f}" for r in runs)
-        table.add(f"two sliders, {ens_realizations} x {ens_steps:,} steps, slidernet.run on 2 workers / 1",
-                  "x", ens["rate"], ratio="no C counterpart", target=">= 1.9",
-                  ours_text=f"{ens['rate']:.2f} x ({ens['two'] / 1e6:.1f} / {ens['one'] / 1e6:.1f} M/s; CPU share "
-                            f"{ens['share_two']:.2f} / {ens['share_one']:.2f}"
-                            + (f"; median of {n}, by run {by_run})" if n > 1 else ")"),
-                  slips=(ens["slips"], None))
+        if "workers" in rows:
+            # 3. 2 workers against 1 (slidernet.run, execution.workers); a speed-up per run, its median
+            runs = []
+            for _ in range(n):
+                ens = run_child("workers", {"steps": ens_steps, "realizations": ens_realizations, "workers": 2},
+                                None)
+                one, two = ens["1"], ens["2"]
+                if one["slips"] != two["slips"]:
+                    raise AssertionError(f"slidernet.run: {one['slips']} slips on 1 worker, {two['slips']} on 2")
+                runs.append({"rate": two["rate"] / one["rate"], "one": one["rate"], "two": two["rate"],
+                             "share_one": one["cpu_share"], "share_two": two["cpu_share"], "slips": two["slips"]})
+            ens = _median(runs)
+            by_run = ", ".join(f"{r['rate']:.2f}" for r in runs)
+            table.add(f"two sliders, {ens_realizations} x {ens_steps:,} steps, slidernet.run on 2 workers / 1",
+                      "x", ens["rate"], ratio="no C counterpart", target=">= 1.9",
+                      ours_text=f"{ens['rate']:.2f} x ({ens['two'] / 1e6:.1f} / {ens['one'] / 1e6:.1f} M/s; "
+                                f"CPU share {ens['share_two']:.2f} / {ens['share_one']:.2f}"
+                                + (f"; median of {n}, by run {by_run})" if n > 1 else ")"),
+                      slips=(ens["slips"], None))
 
-        # 4. the small lattice
-        small, c_small, r_small, r_c_small = repeated(
-            n, lambda: run_child("lattice", {"size": SMALL, "steps": small_steps}, core),
-            (lambda: c_lattice(exe["lattice"], SMALL, small_steps, core)) if exe else None)
-        shares += [small["cpu_share"]] + ([c_small["cpu_share"]] if c_small else [])
-        table.add(f"triangular {SMALL} x {SMALL}, {small_steps} steps, kernel alone", "M/s", small["rate"],
-                  c_small and c_small["rate"], target=">= 1.2",
-                  slips=(small["slips"], c_small and c_small["slips"]),
-                  mu=(small["mean_mu"], c_small and c_small["mean_mu"]),
-                  ours_text=f"{small['rate'] / 1e6:.2f} M/s{_spread(r_small, r_c_small)}")
+        if "lattices" in rows:
+            # 4. the small lattice
+            small, c_small, r_small, r_c_small = repeated(
+                n, lambda: run_child("lattice", {"size": SMALL, "steps": small_steps}, core),
+                (lambda: c_lattice(exe["lattice"], SMALL, small_steps, core)) if exe else None)
+            shares += [small["cpu_share"]] + ([c_small["cpu_share"]] if c_small else [])
+            table.add(f"triangular {SMALL} x {SMALL}, {small_steps} steps, kernel alone", "M/s", small["rate"],
+                      c_small and c_small["rate"], target=">= 1.2",
+                      slips=(small["slips"], c_small and c_small["slips"]),
+                      mu=(small["mean_mu"], c_small and c_small["mean_mu"]),
+                      ours_text=f"{small['rate'] / 1e6:.2f} M/s{_spread(r_small, r_c_small)}")
 
-        # 5. the large lattices
-        large: dict[int, tuple[dict[str, Any], dict[str, Any] | None]] = {}
-        for L in sizes:
-            big, c_big, _, _ = repeated(
-                n, lambda L=L: run_child("lattice", {"size": L, "steps": big_steps}, core),
-                (lambda L=L: c_lattice(exe["lattice"], L, big_steps, core)) if exe else None)
-            shares += [big["cpu_share"]] + ([c_big["cpu_share"]] if c_big else [])
-            large[L] = (big, c_big)
-            label = f"triangular {L} x {L}, {big_steps} steps"
-            check = {"slips": (big["slips"], c_big and c_big["slips"]),
-                     "mu": (big["mean_mu"], c_big and c_big["mean_mu"])}
-            table.add(f"{label}, setup included", "M/s", big["rate_with_setup"],
-                      c_big and c_big["rate_with_setup"], target=">= 1.0" if L == 1000 else "", **check)
-            table.add(f"{label}, kernel alone", "M/s", big["rate"], c_big and c_big["rate"],
-                      target=">= 1.2" if L == 1000 else "")
-            table.add(f"{label}, setup", "s", big["setup"], c_big and c_big["setup"],
-                      target="<= 0.5 s" if L == 1000 else "",
-                      ours_text=f"{big['setup']:.2f} s (scene {big['scene_s']:.2f} + realization "
-                                f"{big['realization_s']:.2f})")
-            table.add(f"{label}, peak resident memory", "GB", big["peak_GB"], c_big and c_big["peak_GB"],
-                      target="<= 0.6 GB" if L == 1000 else "",
-                      ours_text=f"{big['peak_GB']:.2f} GB ({big['rss_before_setup_GB']:.2f} before setup)")
+            # 5. the large lattices
+            large: dict[int, tuple[dict[str, Any], dict[str, Any] | None]] = {}
+            for L in sizes:
+                big, c_big, _, _ = repeated(
+                    n, lambda L=L: run_child("lattice", {"size": L, "steps": big_steps}, core),
+                    (lambda L=L: c_lattice(exe["lattice"], L, big_steps, core)) if exe else None)
+                shares += [big["cpu_share"]] + ([c_big["cpu_share"]] if c_big else [])
+                large[L] = (big, c_big)
+                label = f"triangular {L} x {L}, {big_steps} steps"
+                check = {"slips": (big["slips"], c_big and c_big["slips"]),
+                         "mu": (big["mean_mu"], c_big and c_big["mean_mu"])}
+                table.add(f"{label}, setup included", "M/s", big["rate_with_setup"],
+                          c_big and c_big["rate_with_setup"], target=">= 1.0" if L == 1000 else "", **check)
+                table.add(f"{label}, kernel alone", "M/s", big["rate"], c_big and c_big["rate"],
+                          target=">= 1.2" if L == 1000 else "")
+                table.add(f"{label}, setup", "s", big["setup"], c_big and c_big["setup"],
+                          target="<= 0.5 s" if L == 1000 else "",
+                          ours_text=f"{big['setup']:.2f} s (scene {big['scene_s']:.2f} + realization "
+                                    f"{big['realization_s']:.2f})")
+                table.add(f"{label}, peak resident memory", "GB", big["peak_GB"], c_big and c_big["peak_GB"],
+                          target="<= 0.6 GB" if L == 1000 else "",
+                          ours_text=f"{big['peak_GB']:.2f} GB ({big['rss_before_setup_GB']:.2f} before setup)")
 
-        # 6. largest lattice against the small one
-        L = sizes[-1]
-        big, c_big = large[L]
-        for key, what in (("rate", "kernel alone"), ("rate_with_setup", "setup included")):
-            ours_r = big[key] / small[key]
-            theirs_r = c_big[key] / c_small[key] if c_big and c_small else None
-            table.add(f"rate at {L} x {L} / at {SMALL} x {SMALL}, {what}", "x", ours_r, theirs_r,
-                      target=">= 0.5" if key == "rate" and L == 1000 else "")
+            # 6. largest lattice against the small one
+            L = sizes[-1]
+            big, c_big = large[L]
+            for key, what in (("rate", "kernel alone"), ("rate_with_setup", "setup included")):
+                ours_r = big[key] / small[key]
+                theirs_r = c_big[key] / c_small[key] if c_big and c_small else None
+                table.add(f"rate at {L} x {L} / at {SMALL} x {SMALL}, {what}", "x", ours_r, theirs_r,
+                          target=">= 0.5" if key == "rate" and L == 1000 else "")
 
-        # 7. an irregular network of the largest size (every node driven: ~20 N slips a step)
-        if not args.no_delaunay:
-            irr = run_child("lattice", {"size": L, "steps": 2, "kind": "irregular"}, core)
-            shares.append(irr["cpu_share"])
-            table.add(f"irregular (Delaunay) {L * L:,} nodes, 2 steps, kernel alone", "M/s", irr["rate"],
-                      ratio="no C counterpart", target="<= 1.5 x" if L == 1000 else "",
-                      ours_text=f"{irr['rate'] / 1e6:.2f} M/s ({big['rate'] / irr['rate']:.2f} x slower than "
-                                f"triangular; setup {irr['setup']:.2f} s, peak {irr['peak_GB']:.2f} GB)",
-                      slips=(irr["slips"], None), mu=(irr["mean_mu"], None))
+            # 7. an irregular network of the largest size (every node driven: ~20 N slips a step)
+            if not args.no_delaunay:
+                irr = run_child("lattice", {"size": L, "steps": 2, "kind": "irregular"}, core)
+                shares.append(irr["cpu_share"])
+                table.add(f"irregular (Delaunay) {L * L:,} nodes, 2 steps, kernel alone", "M/s", irr["rate"],
+                          ratio="no C counterpart", target="<= 1.5 x" if L == 1000 else "",
+                          ours_text=f"{irr['rate'] / 1e6:.2f} M/s ({big['rate'] / irr['rate']:.2f} x slower than "
+                                    f"triangular; setup {irr['setup']:.2f} s, peak {irr['peak_GB']:.2f} GB)",
+                          slips=(irr["slips"], None), mu=(irr["mean_mu"], None))
 
         # 8. irregular networks against network.c, the same network (written by slidernet), kernel alone
-        if not args.no_irregular_c:
+        if "irregular" in rows and not args.no_irregular_c:
             irr_rates: dict[int, tuple[float, float | None]] = {}
             for nodes, steps in IRREGULAR_Q if q else IRREGULAR:
                 file = str(Path(tmp) / f"irregular_{nodes}.txt")
@@ -659,10 +674,12 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(table.markdown())
     print()
-    low = " (below 0.95: another process took the core, the rates are low for that reason)" \
-        if min(shares) < 0.95 else ""
-    print(f"wall time {wall:.0f} s; load average {os.getloadavg()[0]:.2f}; CPU share of the pinned runs "
-          f"{min(shares):.2f} - {max(shares):.2f}{low}")
+    pinned = ""
+    if shares:  # row 3 alone runs nothing pinned
+        low = " (below 0.95: another process took the core, the rates are low for that reason)" \
+            if min(shares) < 0.95 else ""
+        pinned = f"; CPU share of the pinned runs {min(shares):.2f} - {max(shares):.2f}{low}"
+    print(f"wall time {wall:.0f} s; load average {os.getloadavg()[0]:.2f}{pinned}")
     if args.csv is not None:
         table.write_csv(args.csv)
     return 0
