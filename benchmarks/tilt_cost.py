@@ -28,22 +28,24 @@ steps), then given as the mean over realizations +- its standard error
 (``slidernet.analysis.trend.mean_sem``): the realizations are independent,
 the tests of one realization are not (same state). The figures:
 
-* seconds per test, as a user pays it: the call includes the reruns of a
-  test that ran out of tilt draws (the draw buffers start at
-  ``solver.batch`` values and double; a test that runs out starts again from
-  the start, so the first test of a realization pays for growing them);
+* seconds per test, as a user pays it: the call includes the refills of a
+  test that ran out of tilt draws (the threshold buffer starts at
+  ``solver.batch`` values and doubles; a test that runs out goes on where
+  it stood, ``Streams.extend_tilt``; before commit f52d954 it started again
+  from its beginning, and the first test of a realization paid for growing
+  the buffers);
 * the same per node (microseconds);
 * slips per test: the thresholds the test drew from the tilt stream
   (one per slip, read from the public ``Realization.buffers`` and
   ``Realization.state["tilt_mu_pos"]``), plus the slip that sets the network
   sliding, which draws none; per node as well;
 * the slip rate of the tests (slips / seconds, per realization), apart for
-  the tests that did not refill the draw buffers (the test's own rate) and
-  for those that did (they ran again from the start at least once; the
-  slips counted are those of the run that slid), with the share of tests
-  that refilled. The scenes record no ``mu_eff``, so a realization's tilt
-  buffers start empty and its first test refills at its first slip (one
-  slip of work lost), then again each time it outgrows them;
+  the tests that did not refill the draw buffers and for those that did
+  (before f52d954 they ran again from the start at least once; the slips
+  counted are those of the run that slid), with the share of tests that
+  refilled. The scenes record no ``mu_eff``, so a realization's tilt
+  buffers start empty and its first test refills at its first slip, then
+  again each time it outgrows them;
 * the seconds of one thermal step of the same realizations and the ratio
   test / step (per realization, then averaged);
 * mu_eff, the test's result, for reference.
@@ -175,16 +177,16 @@ def timed_test(real: Realization) -> dict[str, Any]:
     dict
         ``seconds`` (wall), ``cpu`` (process CPU seconds), ``mu_eff`` (NaN if
         the test did not reach sliding), ``slips`` (0 then), ``slid`` and
-        ``refilled`` (the test ran out of tilt draws at least once, so ran
-        again from the start; always True for a test that did not slide).
+        ``refilled`` (the test ran out of tilt draws at least once; always
+        True for a test that did not slide).
 
     Notes
     -----
     The slips are the thresholds read from the tilt stream, plus one. The
     test reads one per slip except the slip that sets the network sliding,
     and its read position advances only when it returns a sample; a test
-    that ran out of draws got a new buffer (the unread tail, then new
-    draws) and ran again from the start of it.
+    that ran out of draws got a new buffer (from the test's first draw on,
+    then new draws), read from 0.
     """
     buf0, pos0 = _tilt_read(real)
     c0, t0 = time.process_time(), time.perf_counter()
