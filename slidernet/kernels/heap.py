@@ -48,6 +48,7 @@ from slidernet.kernels.state import (
     UNSTABLE,
     UP,
     kernel_jit,
+    nonneg,
 )
 
 
@@ -68,7 +69,7 @@ def _up(heaps, w, h):
     node = heaps.node[w, h]
     key = heaps.key[w, h]
     while h > 0:
-        p = (h - 1) >> 1
+        p = nonneg((h - 1) >> 1)
         if not _before(key, node, heaps.key[w, p], heaps.node[w, p]):
             break
         _place(heaps, w, h, heaps.node[w, p], heaps.key[w, p])
@@ -82,12 +83,12 @@ def _down(heaps, w, h, size):
     node = heaps.node[w, h]
     key = heaps.key[w, h]
     while True:
-        c = 2 * h + 1
+        c = nonneg(2 * h + 1)
         if c >= size:
             break
-        if c + 1 < size and _before(heaps.key[w, c + 1], heaps.node[w, c + 1], heaps.key[w, c],
-                                    heaps.node[w, c]):
-            c += 1
+        c1 = nonneg(c + 1)
+        if c1 < size and _before(heaps.key[w, c1], heaps.node[w, c1], heaps.key[w, c], heaps.node[w, c]):
+            c = c1
         if not _before(heaps.key[w, c], heaps.node[w, c], key, node):
             break
         _place(heaps, w, h, heaps.node[w, c], heaps.key[w, c])
@@ -108,12 +109,12 @@ def heap_set(heaps, w, node, key, present):
             if h2 == h:
                 _down(heaps, w, h, heaps.size[w])
         else:
-            size = heaps.size[w]
+            size = nonneg(heaps.size[w])
             _place(heaps, w, size, node, key)
             heaps.size[w] = size + 1
             _up(heaps, w, size)
     elif h >= 0:
-        last = heaps.size[w] - 1
+        last = nonneg(heaps.size[w] - 1)
         heaps.size[w] = last
         heaps.slot[node, w] = -1
         if h != last:
@@ -129,6 +130,7 @@ def _group_lead(tk, tw, r, first):
     The entries of a group lead disjoint runs of leaves in node order, so the
     first of the largest keys is also the lowest node among them: the tie rule.
     """
+    first = nonneg(first)
     best = first
     bk = tk[r, first]
     for c in range(first + 1, first + TREE_ARITY):
@@ -152,7 +154,7 @@ def tree_set(heaps, r, node, key):
     # Where every node is driven the leaves are the nodes: no lookup, whose
     # cache miss the key's load would wait for (0.61 -> 0.73 M slips/s,
     # irregular 1e6 nodes, one core).
-    i = heaps.leaf[node] if heaps.leaf.size else node
+    i = nonneg(heaps.leaf[node]) if heaps.leaf.size else node
     old_k = tk[r, i]
     if old_k == key:
         return
@@ -162,14 +164,14 @@ def tree_set(heaps, r, node, key):
     new_w = node
     for lev in range(off.size - 2):
         p = i // TREE_ARITY
-        at = off[lev + 1] + p
+        at = nonneg(off[lev + 1] + p)
         pk = tk[r, at]
         pw = tw[r, at]
         if pw == old_w:
             # The changed entry led its group: it still does if it did not fall
             # behind, else the group is scanned again.
             if not _before(new_k, new_w, old_k, old_w) and not (new_k == old_k and new_w == old_w):
-                new_k, new_w = _group_lead(tk, tw, r, off[lev] + p * TREE_ARITY)
+                new_k, new_w = _group_lead(tk, tw, r, nonneg(off[lev] + p * TREE_ARITY))
         elif not _before(new_k, new_w, pk, pw):
             return  # another entry leads the group and still does
         if new_k == pk and new_w == pw:
@@ -212,7 +214,7 @@ def set_critical(heaps, j, dn, up):
         tree_set(heaps, DOWN, j, dn)
     if not heaps.stale[j]:
         heaps.stale[j] = 1
-        heaps.stale_nodes[heaps.n_stale[0]] = j
+        heaps.stale_nodes[nonneg(heaps.n_stale[0])] = j
         heaps.n_stale[0] += 1
 
 
@@ -314,7 +316,7 @@ def redraw_threshold(st, i, mu, mu_draws, node_slips):
     mu_max is kept incrementally; only when the strongest node itself slips
     (possible in networks, never with two sliders) is it found by a rescan.
     """
-    new = mu_draws[st.mu_pos]
+    new = mu_draws[nonneg(st.mu_pos)]
     st.mu_pos += 1
     old = mu[i]
     mu[i] = new

@@ -43,7 +43,17 @@ from slidernet.kernels.heap import (
     tree_set,
     write_output,
 )
-from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, kernel_jit
+from slidernet.kernels.state import (
+    AVALANCHE_LIMIT,
+    DONE,
+    DOWN,
+    RECOMPUTE,
+    SLID_AWAY,
+    UNSTABLE,
+    UP,
+    kernel_jit,
+    nonneg,
+)
 from slidernet.kernels.tilt import tilt_sample
 
 
@@ -185,7 +195,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
     open_recomputed_avalanche(st, heaps, thetas)
     while True:
         while heaps.size[UNSTABLE] > 0:
-            i = heaps.node[UNSTABLE, 0]
+            i = nonneg(heaps.node[UNSTABLE, 0])
             st.av_slips += 1
             if st.av_slips > settings.max_slips:
                 if settings.slide_away:
@@ -223,6 +233,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
         turn(net, nodes, heaps, s, critical_roots)
         best, thc = next_driving_event(st, heaps, thetas, s)
         if best >= 0:
+            best = nonneg(best)
             st.theta = thc
             status = buffers_low(st, draws, catalogue)
             if status == DONE and settings.do_tilt:

@@ -29,7 +29,7 @@ import math
 from slidernet.kernels.heap import heap_set, set_critical
 from slidernet.kernels.memory import prefetch
 from slidernet.kernels.network import init_heaps, run_network
-from slidernet.kernels.state import UNSTABLE, kernel_jit
+from slidernet.kernels.state import UNSTABLE, kernel_jit, nonneg
 
 SLIP_STRAIGHT = 0
 SLIP_EXACT = 1
@@ -313,8 +313,8 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
     wi = net.w[0] if net.unit_load else net.w[i]
     st.x_G += dux * wi
     st.y_G += duy * wi
-    lo = net.indptr[i]
-    hi = net.indptr[i + 1]
+    lo = nonneg(net.indptr[i])
+    hi = nonneg(net.indptr[i + 1])
     if heaps.leaf.size == 0:
         # Every node is driven (an irregular network): driving events land anywhere, and the
         # neighbours' lines are out of cache at large N. Ask for all of them first so that their
@@ -322,7 +322,7 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
         # its driven boundary, in cache: nothing to gain there.
         r = heaps.active[0]
         for p in range(lo, hi):
-            j = net.indices[p]
+            j = net.indices[nonneg(p)]
             prefetch(nodes.a, j)
             prefetch(net.g, j)
             prefetch(nodes.mu, j)
@@ -330,8 +330,9 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
             prefetch(heaps.stale, j)
             prefetch(heaps.tkey, (r, j))
     for p in range(lo, hi):
-        j = net.indices[p]
-        _pushed(net, nodes.a, p, j, dux, duy)
+        q = nonneg(p)  # lo >= 0, but the compiler does not carry that over to p
+        j = nonneg(net.indices[q])
+        _pushed(net, nodes.a, q, j, dux, duy)
         update_node(net, nodes, heaps, j, theta)
 
 
