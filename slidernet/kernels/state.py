@@ -109,6 +109,7 @@ def cached_jit(**options) -> Callable:
 
     return decorate
 
+
 @kernel_jit(inline="always")
 def nonneg(k):
     """The index k (0 <= k < 2**62) with its two top bits cleared: the same value, known to the compiler
@@ -116,11 +117,12 @@ def nonneg(k):
 
     numba wraps a negative index around (k + size) unless it can prove k >= 0, which costs a compare, a
     select and a load of the array's size at every access with an index read from memory (a node, a
-    slot, an offset); clearing the top bits is one AND, and the wrap-around code folds away. In
-    run_plane's machine code, 121 of those sign tests (``sar $63``) became 33 and the code 7 % shorter;
-    interleaved runs on one core (2026-11-26, best of 2 runs per process) went from 1.20-1.65 to
-    1.47-2.08 M slips/s on an irregular network of 1e4 nodes (+14 to +73 %, every round faster) and from
-    3.57-4.28 to 4.69-5.07 M/s on the 32 x 32 triangular lattice, slips and thresholds unchanged.
+    slot, an offset); clearing the top bits is one AND, and the wrap-around code folds away. Only for
+    indices that cannot be negative: a -1 (no slot, no leaf) would become a huge index, not the last
+    entry. In run_plane's machine code, 121 of those sign tests (``sar $63``) became 33 and the code 7 %
+    shorter; interleaved runs on one core (2026-11-26, slips and thresholds unchanged) gave +14 to +73 %
+    (median of 4 rounds +18 %) on an irregular network of 1e4 nodes and +10 to +39 % on the 32 x 32
+    triangular lattice (performance guide).
     """
     return k & 0x3FFFFFFFFFFFFFFF
 
