@@ -61,7 +61,7 @@ def _before(ka, na, kb, nb):
 def _place(heaps, w, h, node, key):
     heaps.node[w, h] = node
     heaps.key[w, h] = key
-    heaps.slot[node, w] = h
+    heaps.slot[nonneg(node), w] = h  # a node in a heap is a node index, never -1
 
 
 @kernel_jit(inline="always")
@@ -411,7 +411,7 @@ def next_driving_event(st, heaps, thetas, s):
     segment (inclusive at its end); theta_c is clamped to the current theta
     where rounding put it behind.
     """
-    theta_b = thetas[st.q + 1]
+    theta_b = thetas[nonneg(st.q) + 1]
     best = -1
     thc = 0.0
     if s > 0.0:
@@ -431,8 +431,9 @@ def next_driving_event(st, heaps, thetas, s):
 @kernel_jit(inline="always")
 def theta_direction(st, thetas):
     """The sign s of d(theta)/dt in step q: 1.0, -1.0, or 0.0 where theta stands still."""
-    theta_a = thetas[st.q]
-    theta_b = thetas[st.q + 1]
+    q = nonneg(st.q)
+    theta_a = thetas[q]
+    theta_b = thetas[q + 1]
     return 1.0 if theta_b > theta_a else (-1.0 if theta_b < theta_a else 0.0)
 
 
@@ -447,7 +448,7 @@ def open_driving_event(st, thetas, thc):
     below q + 1 instead. Periodic drivers with constant thresholds put
     events exactly on the samples.
     """
-    q = st.q
+    q = nonneg(st.q)
     st.av_slips = 0
     st.in_avalanche = 1
     st.n_events += 1
@@ -458,7 +459,7 @@ def open_driving_event(st, thetas, thc):
 @kernel_jit(inline="always")
 def end_step(st, thetas, out_steps):
     """No node reaches its threshold before thetas[q + 1]: go there; True if that step is an output step."""
-    q = st.q
+    q = nonneg(st.q)
     st.q = q + 1
     st.theta = thetas[q + 1]
     return st.next_out < out_steps.size and out_steps[st.next_out] == q + 1

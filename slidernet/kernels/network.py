@@ -130,7 +130,7 @@ def turn(net, nodes, heaps, s, critical_roots):
         return
     heaps.active[0] = want
     for k in range(heaps.n_stale[0]):
-        j = heaps.stale_nodes[k]
+        j = nonneg(heaps.stale_nodes[k])
         heaps.stale[j] = 0
         dn, up = critical_roots(net, nodes, j)
         if want == UP:
