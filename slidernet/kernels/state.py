@@ -141,8 +141,8 @@ TILT_MAX_ITER = 1_000_000
 
 # What a tilt test (the pair's or the network's) returns where it gives no sample; a sample, the load
 # at which the system slides, is > mu_d > 0. slidernet.kernels.tilt.tilt_status maps these to the codes above.
-TILT_NEED_DRAWS = -1.0  # a draw buffer ran out (the test's read positions are left as they were)
-TILT_TOO_LONG = -2.0  # the test gave up: TILT_MAX_ITER iterations, or an endless avalanche at or below mu_d
+TILT_NEED_DRAWS = -1.0  # a draw buffer ran out (pair: positions left as they were; network: it resumes)
+TILT_TOO_LONG = -2.0  # the test gave up: TILT_MAX_ITER iterations (pair), or why in pos[STOP] (network)
 N_AVALANCHE_BINS = 63  # avalanche sizes s are binned by floor(log2 s); 2**62 fits in int64
 
 #: The scalars of a realization, one record. Units are the kernels' (theta in
