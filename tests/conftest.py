@@ -3,7 +3,12 @@
 from __future__ import annotations
 
 import copy
+import os
+import subprocess
+import sys
+import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,6 +22,57 @@ from slidernet.solver import Realization, Scene
 # No hypothesis example may fail for taking long: the suite runs on slow and loaded machines too.
 settings.register_profile("slidernet", deadline=None)
 settings.load_profile("slidernet")
+
+
+def _kernels_compiled() -> dict[str, bool]:
+    """Whether numba's cache already holds each part's largest kernel (``tests/warm_kernels.py``)."""
+    from slidernet import kernels
+
+    def cached(dispatcher: Any) -> bool:
+        # numba's own cache index of the function (private names: if they move, compile again, which
+        # only loads what is cached).
+        try:
+            return os.path.exists(dispatcher._cache._cache_file._index_path)
+        except AttributeError:
+            return False
+
+    return {"1d": cached(kernels.run_chain) and cached(kernels.run_pair), "2d": cached(kernels.run_plane)}
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Compile the kernels once, in parallel, before pytest-xdist starts its workers.
+
+    Each worker would otherwise compile every kernel it meets: the same
+    minutes of numba's compiler once per worker (about 3.7 CPU-minutes for
+    all of them). The controller runs ``tests/warm_kernels.py`` once per
+    part, side by side, only for the parts whose kernels are not in the
+    cache yet; the workers then load them from the cache.
+    """
+    workers = getattr(config.option, "numprocesses", None)  # None without pytest-xdist
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
+        return
+    parts = [part for part, done in _kernels_compiled().items() if not done]
+    if not parts:
+        return
+    t0 = time.perf_counter()
+    script = Path(__file__).with_name("warm_kernels.py")
+    procs = {part: subprocess.Popen([sys.executable, str(script), part], stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True) for part in parts}
+    outputs = {part: proc.communicate()[0] for part, proc in procs.items()}
+    note = f"kernels compiled before the workers started: {', '.join(parts)} in {time.perf_counter() - t0:.0f} s"
+    failed = [f"{part}: {outputs[part].strip().splitlines()[-1:]}" for part, proc in procs.items()
+              if proc.returncode != 0]
+    if failed:
+        note += f" (failed, left to the tests: {'; '.join(failed)})"
+    config.stash[_WARM_NOTE] = note
+
+
+_WARM_NOTE = pytest.StashKey[str]()
+
+
+def pytest_report_header(config: pytest.Config) -> str | None:
+    return config.stash.get(_WARM_NOTE, None)
+
 
 # docs/model.md section 5, as a dict, exactly as written there.
 REFERENCE: dict[str, Any] = {
