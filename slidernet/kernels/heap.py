@@ -200,7 +200,7 @@ def tree_top(heaps, r):
     off = heaps.toff
     if off.size < 2:
         return -1, 0.0
-    top = off[off.size - 2]
+    top = nonneg(off[off.size - 2])  # an offset into the tree's rows
     return heaps.twin[r, top], heaps.tkey[r, top]
 
 
@@ -347,7 +347,7 @@ def log_event(st, catalogue, i, dux, duy):
     slip; with the catalogue off the buffer has no rows and nothing is
     written.
     """
-    k = st.ev_pos
+    k = nonneg(st.ev_pos)  # rows written so far: 0 or more
     if k < catalogue.ids.shape[0]:
         catalogue.ids[k, 0] = i
         catalogue.ids[k, 1] = st.n_events

@@ -268,13 +268,13 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         slips += 1
         av_slips += 1
         pos[N_SLIPS] = slips
-        loads[L_F] = f
+        # loads[L_F] is written where the test returns (f changes only just above, at a driving slip).
         if slips > settings.max_slips:
-            return _give_up(pos, STOP_SLIPS)
+            return _give_up(pos, loads, f, STOP_SLIPS)
         if av_slips > av_cap:
             if f + f_bar > settings.mu_d:
-                return _sample(pos, p_mu, p_u, f + f_bar)
-            return _give_up(pos, STOP_PART)
+                return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
+            return _give_up(pos, loads, f, STOP_PART)
         if epoch[i] != ep:
             if heaps.slot[i, _UNSTABLE] >= 0:
                 pending -= 1
@@ -282,7 +282,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             moved += 1
         ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu)
         if not ok:
-            return _give_up(pos, STOP_SLIP_MOTION)
+            return _give_up(pos, loads, f, STOP_SLIP_MOTION)
         spread(net, G, i, dux, duy)
         for p in range(net.indptr[i], net.indptr[i + 1]):
             j = net.indices[p]
@@ -298,7 +298,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             if math.isnan(loads[L_MOVING]):
                 loads[L_MOVING] = f + f_bar
             if f + f_bar > settings.mu_d:
-                return _sample(pos, p_mu, p_u, f + f_bar)
+                return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
             if pair_rule:
                 stage = R_CREEP
                 continue
@@ -314,8 +314,9 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
 
 
 @kernel_jit(inline="always")
-def _sample(pos, p_mu, p_u, load):
-    """End the test with a sample, the load f + f_bar: the read positions after its draws."""
+def _sample(pos, loads, f, p_mu, p_u, load):
+    """End the test with a sample, the load f + f_bar: the read positions after its draws, and f."""
+    loads[L_F] = f
     pos[P_MU] = p_mu
     pos[P_U] = p_u
     pos[STAGE] = 0
@@ -323,8 +324,9 @@ def _sample(pos, p_mu, p_u, load):
 
 
 @kernel_jit(inline="always")
-def _give_up(pos, why):
-    """End the test without a sample (``TILT_TOO_LONG``); ``why`` goes to ``pos[STOP]``."""
+def _give_up(pos, loads, f, why):
+    """End the test without a sample (``TILT_TOO_LONG``); ``why`` goes to ``pos[STOP]``, f to ``loads[L_F]``."""
+    loads[L_F] = f
     pos[STOP] = why
     pos[STAGE] = 0
     return TILT_TOO_LONG

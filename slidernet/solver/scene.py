@@ -80,8 +80,12 @@ def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: n
     indices = indices.astype(np.int32, copy=False)
     K_id = K_id.astype(np.int32, copy=False)
     per_entry = K_table.shape[0] == K_id.size and bool((K_id == np.arange(K_id.size)).all())
+    diag = diagonal_positions(indptr, indices)
+    if diag.size and diag.min() < 0:
+        # The kernels read K_ii at diag[i] without a sign test (kernels.state.nonneg).
+        raise ValueError(f"row {int(np.argmin(diag))} of K has no diagonal block")
     return Plane(indptr=indptr, indices=indices, K_id=K_id, K_table=K_table,
-                 diag=diagonal_positions(indptr, indices), g=g, normal_load=normal_load, w=w, unit_load=unit_load,
+                 diag=diag, g=g, normal_load=normal_load, w=w, unit_load=unit_load,
                  block_per_entry=per_entry)
 
 
