@@ -120,9 +120,9 @@ def nonneg(k):
     slot, an offset); clearing the top bits is one AND, and the wrap-around code folds away. Only for
     indices that cannot be negative: a -1 (no slot, no leaf) would become a huge index, not the last
     entry. In run_plane's machine code, 121 of those sign tests (``sar $63``) became 33 and the code 7 %
-    shorter; interleaved runs on one core (2026-11-26, slips and thresholds unchanged) gave +14 to +73 %
-    (median of 4 rounds +18 %) on an irregular network of 1e4 nodes and +10 to +39 % on the 32 x 32
-    triangular lattice (performance guide).
+    shorter (16 today, none on the path of a slip); at that first step, interleaved runs on one core
+    (2026-11-26, slips and thresholds unchanged) gave +14 to +73 % (median of 4 rounds +18 %) on an
+    irregular network of 1e4 nodes and +10 to +39 % on the 32 x 32 triangular lattice (performance guide).
     """
     return k & 0x3FFFFFFFFFFFFFFF
 
