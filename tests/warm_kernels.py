@@ -1,8 +1,9 @@
 """Compile slidernet's kernels into numba's on-disk cache: the test suite's warm-up.
 
 ``python tests/warm_kernels.py PART`` runs the tiny scenes of one part of
-:data:`PARTS`; each part compiles a disjoint set of kernels, so that the
-parts can compile side by side. ``tests/conftest.py`` runs one process per
+:data:`PARTS`: the 1D kernels (and the validation's), or the 2D ones, so
+that the parts can compile side by side (the few small helpers both use,
+such as the output writer, compile in each). ``tests/conftest.py`` runs one process per
 part before pytest-xdist starts its workers: without it every worker
 compiles every kernel it meets, the same work once per worker. A kernel a
 part misses is still compiled where a test first calls it; nothing here
@@ -71,7 +72,7 @@ def _irregular() -> None:
     _advance({"kind": "irregular", "n": 64, "seed": 0}, observables=["n", "mu_max", "x_G", "mu_eff"])
 
 
-#: Two sets of kernels of about the same compile time: the 1D kernels and the validation's, and the 2D ones.
+#: The 1D kernels and the validation's, and the 2D ones (the 2D part alone: 139 s of CPU on the dev machine).
 PARTS: dict[str, list[Callable[[], None]]] = {
     "1d": [_pair, _pair_csr, _chain, _pair_validation, _ou_driver],
     "2d": [_lattice, _lattice_exact, _irregular],
