@@ -49,7 +49,8 @@ def pytest_configure(config: pytest.Config) -> None:
     cache yet; the workers then load them from the cache.
     """
     workers = getattr(config.option, "numprocesses", None)  # None without pytest-xdist
-    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2 \
+            or config.option.collectonly:
         return
     parts = [part for part, done in _kernels_compiled().items() if not done]
     if not parts:
