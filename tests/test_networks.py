@@ -266,3 +266,15 @@ def test_any_2d_network_relaxes_to_a_stable_balanced_state(seed, kind, ratio, lo
         F = r.forces()
         assert (np.linalg.norm(F, axis=1) <= r.thresholds * (1 + 1e-12)).all()
         np.testing.assert_allclose(F.sum(axis=0), N * f_ext, rtol=0, atol=1e-9)
+
+
+def test_plane_operators_refuse_a_row_without_its_diagonal_block() -> None:
+    # The 2D kernel reads K_ii at diag[i] with no sign test (kernels.state.nonneg): a -1 there must never
+    # reach it. Every network the builders make has K_ii; a hand-made table without it is refused.
+    from slidernet.solver.scene import _plane
+
+    indptr = np.array([0, 2, 3])
+    indices = np.array([0, 1, 0])  # row 1 holds K_10 only
+    with pytest.raises(ValueError, match="row 1 of K has no diagonal block"):
+        _plane(indptr, indices, np.arange(3), np.zeros((3, 2, 2)), np.zeros((2, 2)), np.ones(2),
+               np.full(2, 0.5), True)
