@@ -43,10 +43,11 @@ def pytest_configure(config: pytest.Config) -> None:
     """Compile the kernels once, in parallel, before pytest-xdist starts its workers.
 
     Each worker would otherwise compile every kernel it meets: the same
-    minutes of numba's compiler once per worker (about 3.7 CPU-minutes for
-    all of them). The controller runs ``tests/warm_kernels.py`` once per
-    part, side by side, only for the parts whose kernels are not in the
-    cache yet; the workers then load them from the cache.
+    minutes of numba's compiler once per worker (224 s of CPU for all of
+    them in one process, measured with another job on the machine). The
+    controller runs ``tests/warm_kernels.py`` once per part, side by side,
+    only for the parts whose kernels are not in the cache yet; the workers
+    then load them from the cache.
     """
     workers = getattr(config.option, "numprocesses", None)  # None without pytest-xdist
     if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2 \
@@ -61,8 +62,8 @@ def pytest_configure(config: pytest.Config) -> None:
                                     stderr=subprocess.STDOUT, text=True) for part in parts}
     outputs = {part: proc.communicate()[0] for part, proc in procs.items()}
     note = f"kernels compiled before the workers started: {', '.join(parts)} in {time.perf_counter() - t0:.0f} s"
-    failed = [f"{part}: {outputs[part].strip().splitlines()[-1:]}" for part, proc in procs.items()
-              if proc.returncode != 0]
+    failed = [f"{part}: {(outputs[part].strip().splitlines() or ['no output'])[-1]}"
+              for part, proc in procs.items() if proc.returncode != 0]
     if failed:
         note += f" (failed, left to the tests: {'; '.join(failed)})"
     config.stash[_WARM_NOTE] = note

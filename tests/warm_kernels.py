@@ -26,10 +26,14 @@ _FRICTION = {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.0
 _DRIVER = {"name": "gaussian_steps", "sigma_theta": 1e-7}
 
 
-def _advance(network: dict[str, Any], **extra: Any) -> None:
+def _scene(network: dict[str, Any], **extra: Any) -> Scene:
     cfg = {"seed": 1, "realizations": 1, "steps": 4, "record": [0, 2, 4], "network": {"Ntilde": 1e-7, **network},
            "friction": _FRICTION, "driver": _DRIVER, **extra}
-    Realization(Scene.from_config(load_config(cfg)), np.random.SeedSequence(1)).advance()
+    return Scene.from_config(load_config(cfg))
+
+
+def _advance(network: dict[str, Any], **extra: Any) -> None:
+    Realization(_scene(network, **extra), np.random.SeedSequence(1)).advance()
 
 
 def _pair() -> None:
@@ -48,9 +52,7 @@ def _pair_validation() -> None:
     from slidernet.validation import tilt_readings
     from slidernet.validation.speed_error import fixed_step_final
 
-    cfg = {"seed": 1, "realizations": 1, "steps": 2, "record": [0, 2], "network": {"kind": "two_slider",
-           "Ntilde": 1e-7}, "friction": _FRICTION, "driver": _DRIVER}
-    fixed_step_final(Scene.from_config(load_config(cfg)), [np.random.SeedSequence(1)], 1.0)
+    fixed_step_final(_scene({"kind": "two_slider"}), [np.random.SeedSequence(1)], 1.0)
     tilt_readings.readings(tilt_readings.case_config(0.5, 10.0, 4, 1, 1))
 
 
@@ -72,7 +74,8 @@ def _irregular() -> None:
     _advance({"kind": "irregular", "n": 64, "seed": 0}, observables=["n", "mu_max", "x_G", "mu_eff"])
 
 
-#: The 1D kernels and the validation's, and the 2D ones (the 2D part alone: 139 s of CPU on the dev machine).
+#: The 1D kernels and the validation's, and the 2D ones (the 2D part alone: 139 s of CPU on the dev machine,
+#: another job beside it).
 PARTS: dict[str, list[Callable[[], None]]] = {
     "1d": [_pair, _pair_csr, _chain, _pair_validation, _ou_driver],
     "2d": [_lattice, _lattice_exact, _irregular],

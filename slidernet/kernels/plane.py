@@ -265,7 +265,7 @@ def slip_under(net, settings, i, Fx, Fy, norm, mag):
     budget. Used by the kernel and by the network tilt test.
     """
     fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
-    b = block_of(net, nonneg(net.diag[i]))  # the diagonal block K_ii (diag >= 0: checked by scene._plane)
+    b = block_of(net, net.diag[i])  # the diagonal block K_ii
     K = net.K_table
     kxx = K[b, 0, 0]
     kxy = K[b, 0, 1]
@@ -284,7 +284,8 @@ def block_of(net, p):
     Skipping K_id there (any network but a lattice) spares a load that the
     block's own load would wait for, and K_id's cache lines (4 bytes per entry).
     """
-    # p is an entry of K's rows and K_id a row of K_table: neither is ever negative.
+    # p is an entry of K's rows (diag[i] included: the scene checks that every row holds K_ii) and K_id a
+    # row of K_table: neither is ever negative.
     return nonneg(p) if net.block_per_entry else nonneg(net.K_id[nonneg(p)])
 
 
