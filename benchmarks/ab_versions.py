@@ -33,7 +33,9 @@ ROOT = HERE.parent
 _RATE = re.compile(r"([0-9.]+) M\b")
 
 
-def _run(script: str, args: str, package_root: Path, cache: Path, core: int | None) -> str:
+def run_pinned(script: str, args: str, package_root: Path, cache: Path, core: int | None) -> str:
+    """stdout of ``benchmarks/SCRIPT ARGS`` run against the package at ``package_root``, with its own numba cache,
+    pinned to ``core`` where ``taskset`` exists (``knockout.py`` uses it too)."""
     env = {**os.environ, "PYTHONPATH": str(package_root), "NUMBA_CACHE_DIR": str(cache)}
     cmd = [sys.executable, str(HERE / script), *shlex.split(args)]
     if core is not None and shutil.which("taskset"):
@@ -75,11 +77,11 @@ def main(argv: list[str] | None = None) -> int:
             results: dict[tuple[str, str, str], list[list[float]]] = {}
             for name, root in versions.items():  # compile each version's kernels into its own cache, untimed
                 for script, a in runs:
-                    _run(script, a, root, Path(tmp) / f"cache-{name}", args.core)
+                    run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
             for rnd in range(args.rounds):
                 for script, a in runs:
                     for name, root in versions.items():
-                        out = _run(script, a, root, Path(tmp) / f"cache-{name}", args.core)
+                        out = run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
                         print(f"--- round {rnd + 1}, {name}, {script}\n{out}", flush=True)
                         for label, rates in _rates(out).items():
                             results.setdefault((script, label, name), []).append(rates)
