@@ -17,6 +17,7 @@ of each line for A and B and their ratio B/A.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
 import shlex
@@ -25,6 +26,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -41,6 +43,18 @@ def run_pinned(script: str, args: str, package_root: Path, cache: Path, core: in
     if core is not None and shutil.which("taskset"):
         cmd = ["taskset", "-c", str(core), *cmd]
     return subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=package_root).stdout
+
+
+@contextlib.contextmanager
+def worktree(path: Path, rev: str) -> Iterator[Path]:
+    """A detached git worktree of revision ``rev`` at ``path``, removed on exit (``knockout.py`` uses it too)."""
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(path), rev],
+                   check=True, capture_output=True)
+    try:
+        yield path
+    finally:
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(path)],
+                       check=False, capture_output=True)
 
 
 def _rates(text: str) -> dict[str, list[float]]:
@@ -67,35 +81,29 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--pair", default="--steps 30000 --workers 1", help="arguments of bench_two_slider.py")
     ap.add_argument("--networks", default="--sizes 32 316 --slips 3000000", help="arguments of bench_networks.py")
     args = ap.parse_args(argv)
-    with tempfile.TemporaryDirectory(prefix="slidernet-ab-") as tmp:
-        base = Path(tmp) / "base"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(base), args.base],
-                       check=True, capture_output=True)
-        try:
-            versions = {"A": base, "B": ROOT}
-            runs = [("bench_two_slider.py", args.pair), ("bench_networks.py", args.networks)]
-            results: dict[tuple[str, str, str], list[list[float]]] = {}
-            for name, root in versions.items():  # compile each version's kernels into its own cache, untimed
-                for script, a in runs:
-                    run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
-            for rnd in range(args.rounds):
-                for script, a in runs:
-                    for name, root in versions.items():
-                        out = run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
-                        print(f"--- round {rnd + 1}, {name}, {script}\n{out}", flush=True)
-                        for label, rates in _rates(out).items():
-                            results.setdefault((script, label, name), []).append(rates)
-            print(f"\nMedian rates over {args.rounds} rounds (M/s), A = {args.base}, B = working tree:")
-            for (script, label, name), values in sorted(results.items()):
-                if name != "A" or (script, label, "B") not in results:
-                    continue
-                a = [statistics.median(col) for col in zip(*values, strict=True)]
-                b = [statistics.median(col) for col in zip(*results[(script, label, "B")], strict=True)]
-                cells = "  ".join(f"{x:.3g} -> {y:.3g} ({y / x:.3f})" for x, y in zip(a, b, strict=True))
-                print(f"{script:22s} {label[:40]:40s} {cells}")
-        finally:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(base)],
-                           check=False, capture_output=True)
+    with (tempfile.TemporaryDirectory(prefix="slidernet-ab-") as tmp,
+          worktree(Path(tmp) / "base", args.base) as base):
+        versions = {"A": base, "B": ROOT}
+        runs = [("bench_two_slider.py", args.pair), ("bench_networks.py", args.networks)]
+        results: dict[tuple[str, str, str], list[list[float]]] = {}
+        for name, root in versions.items():  # compile each version's kernels into its own cache, untimed
+            for script, a in runs:
+                run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
+        for rnd in range(args.rounds):
+            for script, a in runs:
+                for name, root in versions.items():
+                    out = run_pinned(script, a, root, Path(tmp) / f"cache-{name}", args.core)
+                    print(f"--- round {rnd + 1}, {name}, {script}\n{out}", flush=True)
+                    for label, rates in _rates(out).items():
+                        results.setdefault((script, label, name), []).append(rates)
+        print(f"\nMedian rates over {args.rounds} rounds (M/s), A = {args.base}, B = working tree:")
+        for (script, label, name), values in sorted(results.items()):
+            if name != "A" or (script, label, "B") not in results:
+                continue
+            a = [statistics.median(col) for col in zip(*values, strict=True)]
+            b = [statistics.median(col) for col in zip(*results[(script, label, "B")], strict=True)]
+            cells = "  ".join(f"{x:.3g} -> {y:.3g} ({y / x:.3f})" for x, y in zip(a, b, strict=True))
+            print(f"{script:22s} {label[:40]:40s} {cells}")
     return 0
 
 

@@ -31,6 +31,7 @@ costs alone.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import statistics
 import subprocess
@@ -38,10 +39,9 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from ab_versions import run_pinned
+from ab_versions import run_pinned, worktree
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
 PATCHES = HERE / "knockout"
 
 
@@ -63,52 +63,44 @@ def main(argv: list[str] | None = None) -> int:
     for patch in patches:
         if not patch.is_file():
             ap.error(f"no patch file {patch}")
-    with tempfile.TemporaryDirectory(prefix="slidernet-knockout-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="slidernet-knockout-") as tmp, contextlib.ExitStack() as trees:
         patch_of = {p.stem: p.resolve() for p in patches}
-        versions = {"base": Path(tmp) / "base"} | {name: Path(tmp) / name for name in patch_of}
-        made: list[Path] = []
-        try:
-            for name, root in versions.items():
-                subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(root), "HEAD"],
-                               check=True, capture_output=True)
-                made.append(root)
-                if name in patch_of:
-                    subprocess.run(["git", "-C", str(root), "apply", str(patch_of[name])], check=True)
+        versions = {name: trees.enter_context(worktree(Path(tmp) / name, "HEAD")) for name in ["base", *patch_of]}
+        for name, patch in patch_of.items():
+            subprocess.run(["git", "-C", str(versions[name]), "apply", str(patch)], check=True)
 
-            def run(name: str, n: int, steps: int, core: int | None = args.core) -> tuple[int, float]:
-                params = json.dumps({"n": n, "steps": steps, "file": str(Path(tmp) / f"net{n}-{name}.txt")})
-                out = run_pinned("bench_vs_c.py", f"--child irregular '{params}'", versions[name],
-                                 Path(tmp) / f"cache-{name}", core)
-                return _rate(out)
+        def run(name: str, n: int, steps: int, file: str, core: int | None = args.core) -> tuple[int, float]:
+            params = json.dumps({"n": n, "steps": steps, "file": str(Path(tmp) / file)})
+            out = run_pinned("bench_vs_c.py", f"--child irregular '{params}'", versions[name],
+                             Path(tmp) / f"cache-{name}", core)
+            return _rate(out)
 
-            with ThreadPoolExecutor(max_workers=2) as pool:  # compile, untimed, two versions at a time
-                list(pool.map(lambda name: run(name, 1000, 2, None), versions))
-            names = list(versions)
-            rates: dict[str, list[float]] = {name: [] for name in names}
-            for rnd in range(args.rounds):
-                k = rnd % len(names)
-                slips = {}
-                for name in names[k:] + names[:k]:
-                    slips[name], rate = run(name, args.n, args.steps)
-                    rates[name].append(rate)
-                    print(f"round {rnd + 1}  {name:14s} {slips[name]} slips  {rate / 1e6:.3f} M/s", flush=True)
-                if len(set(slips.values())) != 1:
-                    raise SystemExit(f"The versions made different numbers of slips: {slips}. A patch changed the "
-                                     "physics, so its time is not the cost of a repeated part.")
-            print(f"\n{args.n} irregular nodes, {args.steps} steps, {args.rounds} rounds on core {args.core}:")
-            print("| version | median M slips/s | ratio to base, median (range) | extra ns a slip, median |")
-            print("|---|---|---|---|")
-            base = rates["base"]
-            print(f"| base | {statistics.median(base) / 1e6:.3f} | | |")
-            for name in names[1:]:
-                ratio = [r / b for r, b in zip(rates[name], base, strict=True)]
-                extra = [1e9 / r - 1e9 / b for r, b in zip(rates[name], base, strict=True)]
-                print(f"| {name} | {statistics.median(rates[name]) / 1e6:.3f} | {statistics.median(ratio):.3f} "
-                      f"({min(ratio):.3f} - {max(ratio):.3f}) | {statistics.median(extra):.0f} |")
-        finally:
-            for root in made:
-                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(root)],
-                               check=False, capture_output=True)
+        # Compile, untimed, two versions at a time: each writes its own small network file. The timed runs
+        # share one file (the child writes it, for network.c, only where it is missing).
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            list(pool.map(lambda name: run(name, 1000, 2, f"warm-{name}.txt", None), versions))
+        names = list(versions)
+        rates: dict[str, list[float]] = {name: [] for name in names}
+        for rnd in range(args.rounds):
+            k = rnd % len(names)
+            slips = {}
+            for name in names[k:] + names[:k]:
+                slips[name], rate = run(name, args.n, args.steps, f"net{args.n}.txt")
+                rates[name].append(rate)
+                print(f"round {rnd + 1}  {name:14s} {slips[name]} slips  {rate / 1e6:.3f} M/s", flush=True)
+            if len(set(slips.values())) != 1:
+                raise SystemExit(f"The versions made different numbers of slips: {slips}. A patch changed the "
+                                 "physics, so its time is not the cost of a repeated part.")
+        print(f"\n{args.n} irregular nodes, {args.steps} steps, {args.rounds} rounds on core {args.core}:")
+        print("| version | median M slips/s | ratio to base, median (range) | extra ns a slip, median |")
+        print("|---|---|---|---|")
+        base = rates["base"]
+        print(f"| base | {statistics.median(base) / 1e6:.3f} | | |")
+        for name in names[1:]:
+            ratio = [r / b for r, b in zip(rates[name], base, strict=True)]
+            extra = [1e9 / r - 1e9 / b for r, b in zip(rates[name], base, strict=True)]
+            print(f"| {name} | {statistics.median(rates[name]) / 1e6:.3f} | {statistics.median(ratio):.3f} "
+                  f"({min(ratio):.3f} - {max(ratio):.3f}) | {statistics.median(extra):.0f} |")
     return 0
 
 
