@@ -35,7 +35,7 @@ def _pair_work(N: int = 2):
 
 
 def _settings(mu_d: float, max_slips: int) -> kernels.Settings:
-    return kernels.Settings(mu_d=mu_d, max_slips=max_slips, recompute_every=0, do_tilt=False, slip_mode=0)
+    return kernels.Settings(mu_d=mu_d, max_slips=max_slips, recompute_every=0)
 
 
 def network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu):

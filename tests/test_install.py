@@ -68,16 +68,16 @@ def test_another_packages_numba_cache_is_left_alone(tmp_path):
 
 
 def test_each_version_of_the_kernels_sources_has_its_own_cache_folder(tmp_path):
-    # numba checks a cached function against its own file only; a kernel inlines helpers of the
-    # other files, so an edit anywhere in kernels/ must lead to another folder.
+    # A kernel compiles helpers of the other files of kernels/ into its machine code, so an edit
+    # anywhere in kernels/ must lead to another folder (tests/test_compile.py runs the whole story).
     import shutil
 
-    from slidernet.kernels import state
+    from slidernet.kernels import jit
 
     copy = tmp_path / "kernels"
-    shutil.copytree(Path(state.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    assert state.folder_digest(copy) == state.sources_digest()
-    assert state.cache_dir().endswith(state.sources_digest())
+    shutil.copytree(Path(jit.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    assert jit.folder_digest(copy) == jit.sources_digest()
+    assert jit.cache_dir().endswith(jit.sources_digest())
     heap = copy / "heap.py"
     heap.write_text(heap.read_text() + "\n# an edit\n")
-    assert state.folder_digest(copy) != state.sources_digest()
+    assert jit.folder_digest(copy) != jit.sources_digest()

@@ -45,7 +45,7 @@ class PairState:
 
     def run(self, thetas, mu_buf, mu_d: float = MU_D) -> int:
         draws = kernels.Draws(np.asarray(mu_buf, dtype=float), np.empty(0), np.empty(0))
-        settings = kernels.Settings(mu_d=mu_d, max_slips=1000, recompute_every=0, do_tilt=False, slip_mode=0)
+        settings = kernels.Settings(mu_d=mu_d, max_slips=1000, recompute_every=0)
         return kernels.run_pair(np.asarray(thetas, dtype=float), self.out_steps, self.mu, self.state, draws,
                                 self.out, settings)
 

@@ -6,12 +6,23 @@ theta/Ntilde. In these units the paper's spring has k = 1, so equation
 `critique` reads theta_c = u + mu_min s and equation `displacement` reads
 Delta u = 2 (mu_min - mu_d) s.
 
-"Model only what a scene needs":
+"Model only what a scene needs", and compile only what it runs:
 
 * :func:`run_pair` (``pair.py``) -- the paper's two sliders: scalars only;
+  :func:`run_pair_tilt` adds the appendix's tilt test before every
+  rearrangement (observable ``mu_eff``);
 * :func:`run_network` (``network.py``) -- any network, one driving loop
   compiled for each geometry: 1D (``chain.py``: scalar forces, CSR rows of
-  K) and 2D (``plane.py``: vector forces, 2x2 blocks of K).
+  K; :func:`run_chain`, and :func:`run_chain_tilt` for a 2-node chain with
+  the appendix's test) and 2D (``plane.py``: vector forces, 2x2 blocks of
+  K; :func:`run_plane`, straight-line slips, and :func:`run_plane_exact`);
+* ``tilt_net.py`` -- the network tilt test at the recorded times, compiled
+  only where a scene asks for it (``tilt_test_network``, and
+  ``tilt_test_network_exact`` for the exact 2D slip).
+
+Each variant is compiled on its first use and cached on disk
+(``jit.py``), so a chain without ``mu_eff`` never compiles a tilt test
+and never a 2D function.
 
 The network kernel finds the next driving event from two tournament trees
 keyed by each driven node's critical theta (one per direction of theta),
@@ -25,9 +36,9 @@ point when a buffer of random draws runs low, so that Python can refill it
 with the plugin's ``sample`` in batches.
 """
 
-from slidernet.kernels.chain import init_chain_heaps, run_chain
-from slidernet.kernels.pair import run_pair
-from slidernet.kernels.plane import init_plane_heaps, run_plane, stiffness_times
+from slidernet.kernels.chain import init_chain_heaps, run_chain, run_chain_tilt
+from slidernet.kernels.pair import run_pair, run_pair_tilt
+from slidernet.kernels.plane import init_plane_heaps, run_plane, run_plane_exact, stiffness_times
 from slidernet.kernels.state import (
     AVALANCHE_LIMIT,
     DONE,
@@ -80,8 +91,11 @@ __all__ = [
     "init_plane_heaps",
     "new_state",
     "run_chain",
+    "run_chain_tilt",
     "run_pair",
+    "run_pair_tilt",
     "run_plane",
+    "run_plane_exact",
     "stiffness_times",
     "tilt_status",
     "tilt_test_pair",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from slidernet.kernels.state import cached_jit
+from slidernet.kernels.jit import cached_jit
 
 
 @cached_jit()
@@ -142,7 +142,7 @@ def assemble_blocks(N: int, i: np.ndarray, j: np.ndarray, k: np.ndarray, unit: n
 SQUARE, TRIANGULAR = 0, 1
 
 
-@cached_jit(inline="always")
+@cached_jit(forceinline=True)
 def _forward(kind, rows, cols, n, m):
     """The m-th spring from node n to a higher-numbered neighbour: (j, class), j = -1 if absent."""
     r = n // cols

@@ -15,11 +15,13 @@ the same floating-point operations as :func:`slidernet.kernels.pair.run_pair`.
 from __future__ import annotations
 
 from slidernet.kernels.heap import heap_set, set_critical
-from slidernet.kernels.network import init_heaps, run_network
-from slidernet.kernels.state import UNSTABLE, kernel_jit, nonneg
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.network import init_heaps, no_tilt, run_network
+from slidernet.kernels.state import UNSTABLE, nonneg
+from slidernet.kernels.tilt import tilt_sample
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def update_node(net, nodes, heaps, j, theta):
     """Re-key node j in the three heaps after its force or threshold changed."""
     a = nodes.a
@@ -35,7 +37,7 @@ def update_node(net, nodes, heaps, j, theta):
         set_critical(heaps, j, dn, up)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def critical_roots(net, nodes, j):
     """(theta_dn, theta_up) of a driven node j: the two roots of |a_j + g_j theta| = mu_s,j N_j."""
     a = nodes.a[j]
@@ -46,7 +48,7 @@ def critical_roots(net, nodes, j):
     return (lim - a) / gj, (-lim - a) / gj
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def slip_displacement(net, nodes, settings, i, theta, driving, s):
     """The slip of node i alone, an undamped half-oscillation: (True, du, 0.0).
 
@@ -64,10 +66,10 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
     return True, 2.0 * (absF - settings.mu_d * net.normal_load[i]) * sgn / net.K_diag[i], 0.0
 
 
-@kernel_jit(inline="always")
-def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
+@kernel_jit(forceinline=True)
+def move_node(net, st, nodes, heaps, i, dux, duy, theta):
     """Displace node i by dux: the centre of mass, and the force offsets on the CSR row of K, each
-    node of the row re-keyed (``update_node``) as soon as its force is moved."""
+    node of the row re-keyed (:func:`update_node`) as soon as its force is moved."""
     nodes.u[i] += dux
     st.x_G += dux * net.w[i]
     # nonneg: the row's bounds, its entries and their nodes are indices >= 0, and numba's wrap-around
@@ -81,17 +83,28 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
         update_node(net, nodes, heaps, j, theta)
 
 
-@kernel_jit(inline="always")
-def pair_force(net, nodes, theta):
-    """The spring force on node 1 of a 2-node chain, F_{1->2} (the appendix's tilt test reads it)."""
-    return nodes.a[1] + net.g[1] * theta
+@kernel_jit(forceinline=True)
+def pair_tilt(net, st, nodes, draws, out, settings):
+    """The appendix's tilt test on a 2-node chain, its sample added to the output bin ``st.next_out``.
+
+    The spring force on node 1, F_{1->2}, is what the test reads.
+    """
+    F = nodes.a[1] + net.g[1] * st.theta
+    return tilt_sample(st, draws, out, st.next_out, F, nodes.mu[0], nodes.mu[1], settings.mu_d)
 
 
 @kernel_jit()
 def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`slidernet.kernels.network.run_network` on a 1D network (``net`` a Chain)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node, pair_force)
+                       update_node, critical_roots, slip_displacement, move_node, no_tilt)
+
+
+@kernel_jit()
+def run_chain_tilt(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
+    """:func:`run_chain` with the appendix's tilt test before every rearrangement (a 2-node chain)."""
+    return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
+                       update_node, critical_roots, slip_displacement, move_node, pair_tilt)
 
 
 @kernel_jit()

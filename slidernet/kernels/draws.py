@@ -19,7 +19,7 @@ they keep the batched path, as plugins do.
 
 from __future__ import annotations
 
-from slidernet.kernels.state import kernel_jit
+from slidernet.kernels.jit import kernel_jit
 
 # Law codes: x = the law's transformation of one Generator draw, with parameters (a, b, c).
 GAUSSIAN = 1  # x = standard_normal() * a + b  (a = std, b = mean), as numpy's x *= std; x += mean
@@ -28,7 +28,7 @@ WEIBULL = 3  # x = a + b * weibull(c)  (a = loc, b = scale, c = shape)
 EXPONENTIAL = 4  # x = a + b * standard_exponential()  (a = loc, b = scale)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def draw(rng, law, a, b, c):
     """One draw of law ``law`` from the Generator ``rng``."""
     if law == GAUSSIAN:

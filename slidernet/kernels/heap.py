@@ -1,9 +1,14 @@
 """Indexed binary max-heaps for the event engine, and the bookkeeping every kernel shares.
 
-The helpers are inlined into the kernels (numba's ``inline="always"``): a
-call that passes a dozen arrays costs more than the sift it performs, and
-inlining the heap and slip helpers made the 2D kernel 35-50 % faster
-(A/B in one process, 1e3 and 1e6 nodes).
+The helpers are inlined into the kernels by LLVM (``forceinline=True``, the
+``alwaysinline`` attribute): a call that passes a dozen arrays costs more
+than the sift it performs (a named tuple of arrays is passed as a hundred
+scalars), and inlining the heap and slip helpers made the 2D kernel
+35-50 % faster (A/B in one process, 1e3 and 1e6 nodes). numba's own
+``inline="always"``, which the helpers used before, inlines them in numba's
+IR, where every copy is typed and lowered again: compiling took 3 to 7
+times longer for the same machine code speed (docs/guides/performance.md,
+"Compiling").
 
 A heap holds node indices ordered by a per-node key (largest first, ties
 to the lowest node index: the tie rule of ARCHITECTURE.md, item 4). The
@@ -39,32 +44,23 @@ from __future__ import annotations
 
 import math
 
-from slidernet.kernels.state import (
-    DONE,
-    DOWN,
-    NEED_EVENTS,
-    NEED_MU,
-    TREE_ARITY,
-    UNSTABLE,
-    UP,
-    kernel_jit,
-    nonneg,
-)
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import DONE, DOWN, NEED_EVENTS, NEED_MU, TREE_ARITY, UNSTABLE, UP, nonneg
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _before(ka, na, kb, nb):
     return ka > kb or (ka == kb and na < nb)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _place(heaps, w, h, node, key):
     heaps.node[w, h] = node
     heaps.key[w, h] = key
     heaps.slot[nonneg(node), w] = h  # a node in a heap is a node index, never -1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _up(heaps, w, h):
     node = heaps.node[w, h]
     key = heaps.key[w, h]
@@ -78,7 +74,7 @@ def _up(heaps, w, h):
     return h
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _down(heaps, w, h, size):
     node = heaps.node[w, h]
     key = heaps.key[w, h]
@@ -96,7 +92,7 @@ def _down(heaps, w, h, size):
     _place(heaps, w, h, node, key)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def heap_set(heaps, w, node, key, present):
     """In heap ``w``: insert ``node`` with ``key``, re-key it, or (``present`` False) remove it."""
     h = heaps.slot[node, w]
@@ -123,7 +119,7 @@ def heap_set(heaps, w, node, key, present):
                 _down(heaps, w, h, last)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _group_lead(tk, tw, r, first):
     """(key, node) leading the group of ``TREE_ARITY`` entries from ``first`` in row r of a tree.
 
@@ -141,7 +137,7 @@ def _group_lead(tk, tw, r, first):
     return bk, tw[r, best]
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def tree_set(heaps, r, node, key):
     """Key the leaf of driven node ``node`` in driving tree r, and update the leads above it.
 
@@ -183,7 +179,7 @@ def tree_set(heaps, r, node, key):
         i = p
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def tree_rebuild(heaps, r):
     """Recompute every lead of driving tree r from its leaves, O(L)."""
     tk = heaps.tkey
@@ -194,7 +190,7 @@ def tree_rebuild(heaps, r):
             tk[r, off[lev + 1] + p], tw[r, off[lev + 1] + p] = _group_lead(tk, tw, r, off[lev] + p * TREE_ARITY)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def tree_top(heaps, r):
     """(node, key) leading driving tree r: node -1 if the tree has no leaves."""
     off = heaps.toff
@@ -204,7 +200,7 @@ def tree_top(heaps, r):
     return heaps.twin[r, top], heaps.tkey[r, top]
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def set_critical(heaps, j, dn, up):
     """Key a driven node j by its critical thetas theta_dn <= theta_up in the active driving tree,
     and list it as stale in the other (one update instead of two)."""
@@ -218,7 +214,7 @@ def set_critical(heaps, j, dn, up):
         heaps.n_stale[0] += 1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def heap_clear(heaps):
     """Empty every heap, and key every leaf of the driving trees -inf (no event)."""
     heaps.slot[:] = -1
@@ -248,7 +244,7 @@ def avalanche_done(st, avalanche_count):
         st.in_avalanche = 0
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def open_initial_relaxation(st, heaps):
     """Open avalanche 0, the relaxation of an overload at t = 0 (a large f_ext), once.
 
@@ -264,7 +260,7 @@ def open_initial_relaxation(st, heaps):
         st.av_slips = -1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def open_recomputed_avalanche(st, heaps, thetas):
     """Open an avalanche for nodes that a recomputation of the forces found over their threshold.
 
@@ -293,7 +289,7 @@ def open_recomputed_avalanche(st, heaps, thetas):
     st.event_time = min(max(time, float(q)), math.nextafter(q + 1.0, q))
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def close_t0(st, out_steps):
     """Close t = 0 once the network is stable; True if the t = 0 output is due now.
 
@@ -309,7 +305,7 @@ def close_t0(st, out_steps):
     return out_steps[st.next_out] == 0
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def redraw_threshold(st, i, mu, mu_draws, node_slips):
     """After node i slipped: draw its new mu_s, keep mu_max and its holder, count the slip.
 
@@ -336,7 +332,7 @@ def redraw_threshold(st, i, mu, mu_draws, node_slips):
     node_slips[i] += 1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def log_event(st, catalogue, i, dux, duy):
     """Append the slip of node i to the event catalogue, if it is recorded.
 
@@ -388,7 +384,7 @@ def write_output(st, mu, out):
     st.next_out = k + 1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def buffers_low(st, draws, catalogue):
     """Why a slip cannot happen now: ``NEED_MU`` (no threshold left to redraw), ``NEED_EVENTS``
     (the catalogue's buffer is full), or ``DONE`` (it can). Checked before every slip, so that a
@@ -400,7 +396,7 @@ def buffers_low(st, draws, catalogue):
     return DONE
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def next_driving_event(st, heaps, thetas, s):
     """The next node to reach its threshold as theta moves linearly from thetas[q] to thetas[q + 1].
 
@@ -428,7 +424,7 @@ def next_driving_event(st, heaps, thetas, s):
     return best, thc
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def theta_direction(st, thetas):
     """The sign s of d(theta)/dt in step q: 1.0, -1.0, or 0.0 where theta stands still."""
     q = nonneg(st.q)
@@ -437,7 +433,7 @@ def theta_direction(st, thetas):
     return 1.0 if theta_b > theta_a else (-1.0 if theta_b < theta_a else 0.0)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def open_driving_event(st, thetas, thc):
     """Start the avalanche of a driving event at theta_c: count it, and stamp its time (q + fraction).
 
@@ -456,7 +452,7 @@ def open_driving_event(st, thetas, thc):
     st.event_time = time if time < q + 1.0 else math.nextafter(q + 1.0, q)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def end_step(st, thetas, out_steps):
     """No node reaches its threshold before thetas[q + 1]: go there; True if that step is an output step."""
     q = nonneg(st.q)

@@ -12,17 +12,24 @@ of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
-* ``move_node(net, st, nodes, heaps, i, du_x, du_y, theta, update_node)``:
+* ``move_node(net, st, nodes, heaps, i, du_x, du_y, theta)``:
   apply it to u, to the centre of mass and to the force offsets of the row
-  of K, re-keying each node of the row (``update_node``) as its force moves;
-* ``pair_force(net, nodes, theta)``: the spring force on node 1 of a pair
-  (the appendix's tilt test).
+  of K, re-keying each node of the row as its force moves;
+* ``tilt(net, st, nodes, draws, out, settings)``: the appendix's tilt test
+  before a rearrangement (a 1D pair, :func:`slidernet.kernels.chain.pair_tilt`)
+  or nothing (:func:`no_tilt`).
 
-The loop is inlined (numba's ``inline="always"``) into each geometry's
-compiled kernel, :func:`~slidernet.kernels.chain.run_chain` and
-:func:`~slidernet.kernels.plane.run_plane`, which pass it their own
-functions: numba resolves the calls when it compiles the kernel, so each
-kernel runs as if the loop had been written for it alone.
+Only the functions that take other functions are inlined into the kernel
+by numba (``inline="always"``: :func:`run_network`, :func:`slip_node`,
+:func:`init_heaps`, :func:`turn`): a function passed as an argument of a
+compiled call would become an address in the machine code, which numba
+cannot cache. Each geometry's kernel (:func:`~slidernet.kernels.chain.run_chain`,
+:func:`~slidernet.kernels.plane.run_plane` and their variants) passes them
+its own functions, resolved when it is compiled, so each kernel runs as if
+the loop had been written for it alone. Every other helper is compiled once
+as a function of its own and inlined by LLVM (``forceinline=True``):
+inlining every helper in numba's IR, as before, made compiling 3 to 7 times
+slower for the same speed (docs/guides/performance.md, "Compiling").
 """
 
 from __future__ import annotations
@@ -43,18 +50,8 @@ from slidernet.kernels.heap import (
     tree_set,
     write_output,
 )
-from slidernet.kernels.state import (
-    AVALANCHE_LIMIT,
-    DONE,
-    DOWN,
-    RECOMPUTE,
-    SLID_AWAY,
-    UNSTABLE,
-    UP,
-    kernel_jit,
-    nonneg,
-)
-from slidernet.kernels.tilt import tilt_sample
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, nonneg
 
 
 @kernel_jit(inline="always")
@@ -82,11 +79,11 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
     # as moving every force first).
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
-    move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node)
+    move_node(net, st, nodes, heaps, i, dux, duy, theta)
     return True
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def every_node_moving(st, nodes, i):
     """Count node i among the nodes the current avalanche has set in motion; True once that is all of them.
 
@@ -104,7 +101,7 @@ def every_node_moving(st, nodes, i):
     return st.n_moving == nodes.mu.size
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def slide_away(st, nodes, out, out_steps):
     """The network slides away: record when, and hold the state of that moment in the records left."""
     st.slid_away = 1
@@ -140,16 +137,15 @@ def turn(net, nodes, heaps, s, critical_roots):
     heaps.n_stale[0] = 0
 
 
-@kernel_jit(inline="always")
-def _tilt(net, st, nodes, draws, out, settings, pair_force):
-    """The appendix's tilt test on the current state of a pair (``settings.do_tilt``)."""
-    return tilt_sample(st, draws, out, st.next_out, pair_force(net, nodes, st.theta), nodes.mu[0],
-                       nodes.mu[1], settings.mu_d)
+@kernel_jit(forceinline=True)
+def no_tilt(net, st, nodes, draws, out, settings):
+    """The ``tilt`` of a kernel without the appendix's test before every rearrangement: nothing, DONE."""
+    return DONE
 
 
 @kernel_jit(inline="always")
 def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings, update_node,
-                critical_roots, slip_displacement, move_node, pair_force):
+                critical_roots, slip_displacement, move_node, tilt):
     """Advance a network through ``thetas`` (units of Ntilde); returns a status code.
 
     Parameters
@@ -173,7 +169,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
     out : Series
         The output series.
     settings : Settings
-        mu_d, max_slips, recompute_every, do_tilt (a 1D pair only), slip_mode.
+        mu_d, max_slips, recompute_every, slide_away.
 
     Returns ``DONE`` at the end of ``thetas``, ``NEED_MU``, ``NEED_TILT`` or
     ``NEED_EVENTS`` when a buffer runs low, ``RECOMPUTE`` every
@@ -205,8 +201,8 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             # The buffer check comes first: a kernel that returns after the
             # tilt sample would take it again on re-entry.
             status = buffers_low(st, draws, catalogue)
-            if status == DONE and settings.do_tilt:
-                status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            if status == DONE:
+                status = tilt(net, st, nodes, draws, out, settings)
             if status != DONE:
                 st.av_slips -= 1
                 return status
@@ -217,10 +213,10 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             if settings.slide_away and every_node_moving(st, nodes, i):
                 return slide_away(st, nodes, out, out_steps)
         avalanche_done(st, nodes.avalanche_count)
-        if st.started == 0 and settings.do_tilt:
+        if st.started == 0:
             # The tilt test before each rearrangement needs f_ext = 0, so
             # there was no initial relaxation: this is the state at t = 0.
-            status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            status = tilt(net, st, nodes, draws, out, settings)
             if status != DONE:
                 return status
         if close_t0(st, out_steps):
@@ -236,8 +232,8 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             best = nonneg(best)
             st.theta = thc
             status = buffers_low(st, draws, catalogue)
-            if status == DONE and settings.do_tilt:
-                status = _tilt(net, st, nodes, draws, out, settings, pair_force)
+            if status == DONE:
+                status = tilt(net, st, nodes, draws, out, settings)
             if status != DONE:
                 return status
             open_driving_event(st, thetas, thc)

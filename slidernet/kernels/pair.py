@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from slidernet.kernels.heap import write_output
-from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, NEED_MU, kernel_jit, nonneg
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, NEED_MU, nonneg
 from slidernet.kernels.tilt import tilt_sample
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _most_overloaded(F, mu0, mu1):
     """The slider that slips next in an avalanche under spring force F: (i, F_i), i = -1 if both are stable.
 
@@ -25,26 +26,45 @@ def _most_overloaded(F, mu0, mu1):
     return -1, 0.0
 
 
+@kernel_jit(forceinline=True)
+def no_tilt(st, draws, out, k, F, mu1, mu2, mu_d):
+    """The ``tilt`` of :func:`run_pair`: no test, DONE (LLVM folds the call away)."""
+    return DONE
+
+
 @kernel_jit()
 def run_pair(thetas, out_steps, mu, state, draws, out, settings):
+    """Advance the two-slider system through ``thetas`` (units of Ntilde): :func:`_run_pair` without the
+    tilt test."""
+    return _run_pair(thetas, out_steps, mu, state, draws, out, settings, no_tilt)
+
+
+@kernel_jit()
+def run_pair_tilt(thetas, out_steps, mu, state, draws, out, settings):
+    """:func:`run_pair` with the appendix's tilt test before every rearrangement (and at t = 0)."""
+    return _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt_sample)
+
+
+@kernel_jit(inline="always")
+def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
     """Advance the two-slider system through ``thetas`` (units of Ntilde).
 
     Slider 1 is index 0, slider 2 is index 1; ``mu`` holds (mu_s,1, mu_s,2).
     The spring force on slider 2 is F = theta - u (eq. `eqF12` in these
     units). The hot state is held in local scalars and written back to
     ``state[0]`` on exit. ``out`` is a :class:`~slidernet.kernels.state.Series`
-    without ``mu_mean``, ``mu_min`` and ``y_G``.
+    without ``mu_mean``, ``mu_min`` and ``y_G``. ``tilt(st, draws, out, k, F,
+    mu1, mu2, mu_d)`` is :func:`~slidernet.kernels.tilt.tilt_sample` (the
+    appendix's test before every rearrangement) or :func:`no_tilt`.
     """
     st = state[0]
     mu_d = settings.mu_d
-    do_tilt = settings.do_tilt
     max_slips = settings.max_slips
     steps = thetas.size - 1
     if st.started == 0:
-        if do_tilt:
-            status = tilt_sample(st, draws, out, st.next_out, st.theta - st.u, mu[0], mu[1], mu_d)
-            if status != DONE:
-                return status
+        status = tilt(st, draws, out, st.next_out, st.theta - st.u, mu[0], mu[1], mu_d)
+        if status != DONE:
+            return status
         if out_steps[st.next_out] == 0:
             write_output(st, mu, out)
         st.started = 1
@@ -84,11 +104,10 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                 av -= 1
                 status = NEED_MU
                 break
-            if do_tilt:
-                status = tilt_sample(st, draws, out, k, F, mu0, mu1, mu_d)
-                if status != DONE:
-                    av -= 1
-                    break
+            status = tilt(st, draws, out, k, F, mu0, mu1, mu_d)
+            if status != DONE:
+                av -= 1
+                break
         else:
             if q >= steps:
                 break
@@ -134,11 +153,10 @@ def run_pair(thetas, out_steps, mu, state, draws, out, settings):
                     if p >= nbuf:
                         status = NEED_MU
                         break
-                    if do_tilt:
-                        # F = theta_c - u, exactly s (tc - v).
-                        status = tilt_sample(st, draws, out, k, s * (tc - v), mu0, mu1, mu_d)
-                        if status != DONE:
-                            break
+                    # F = theta_c - u, exactly s (tc - v).
+                    status = tilt(st, draws, out, k, s * (tc - v), mu0, mu1, mu_d)
+                    if status != DONE:
+                        break
                     d = d1 if one else d0
                     v = v + d
                     xr += (d if one else -d) * 0.5

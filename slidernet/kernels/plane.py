@@ -9,11 +9,11 @@ stable range: they key the driving heaps.
 A slip moves node i alone, the others fixed, as an undamped half-oscillation
 under Coulomb friction with the local stiffness K_ii (a 2x2 block):
 
-* ``slip_mode = 0`` (straight line): along F_i with the stiffness
+* ``solver.slip = "straight"`` (:func:`run_plane`): along F_i with the stiffness
   k = F^T K_ii F / |F|^2 of that line, Delta u_i = 2 (|F_i| - mu_d N_i) F_i / (|F_i| k).
   Exact when K_ii is isotropic (interior nodes of square and triangular
   lattices); an approximation otherwise.
-* ``slip_mode = 1`` (exact): the 2D motion u'' = F_i - K_ii (u - u0) - mu_d N_i v/|v|
+* ``solver.slip = "exact"`` (:func:`run_plane_exact`): the 2D motion u'' = F_i - K_ii (u - u0) - mu_d N_i v/|v|
   is integrated (adaptive RK4, see :func:`exact_slip`) from rest until the
   node sticks. benchmarks/slip_error.py measures what the straight line costs.
 
@@ -27,12 +27,11 @@ from __future__ import annotations
 import math
 
 from slidernet.kernels.heap import heap_set, set_critical
+from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.memory import prefetch
-from slidernet.kernels.network import init_heaps, run_network
-from slidernet.kernels.state import UNSTABLE, kernel_jit, nonneg
+from slidernet.kernels.network import init_heaps, no_tilt, run_network
+from slidernet.kernels.state import UNSTABLE, nonneg
 
-SLIP_STRAIGHT = 0
-SLIP_EXACT = 1
 _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
 
@@ -168,7 +167,7 @@ def integrate_slip(Fx, Fy, kxx, kxy, kyy, fd, steps_per_period, c):
     return x, y, -1
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd):
     """Acceleration of the unit-mass node: elastic force F - K x minus kinetic friction along v."""
     Gx = Fx - (kxx * x + kxy * y)
@@ -182,7 +181,7 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd):
     return 0.0, 0.0
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def update_node(net, nodes, heaps, j, theta):
     """Re-key node j in the three heaps after its force or threshold changed."""
     a = nodes.a
@@ -204,14 +203,14 @@ def update_node(net, nodes, heaps, j, theta):
         set_critical(heaps, j, dn, up)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def critical_roots(net, nodes, j):
     """(theta_dn, theta_up) of a driven node j: the roots of |a_j + g_j theta| = mu_s,j N_j."""
     lim = nodes.mu[j] if net.unit_load else nodes.mu[j] * net.normal_load[j]
     return critical_thetas(nodes.a[j, 0], nodes.a[j, 1], net.g[j, 0], net.g[j, 1], lim)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
     """The straight-line slip: 2 (mag - fd) / k_eff along e = F / norm, k_eff = e^T K_ii e.
 
@@ -237,8 +236,9 @@ def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
 
 
 @kernel_jit(inline="always")
-def slip_displacement(net, nodes, settings, i, theta, driving, s):
-    """The slip of node i alone, the others fixed: (ok, du_x, du_y).
+def _slip_displacement(net, nodes, settings, i, theta, driving, slip):
+    """The slip of node i alone, the others fixed, by the rule ``slip`` (:func:`slip_straight` or
+    :func:`slip_exact`): (ok, du_x, du_y).
 
     A driving slip (``driving``) starts exactly at the threshold,
     |F_i| = mu_s,i N_i, along the force computed at theta divided by that
@@ -252,32 +252,52 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
         absF = nodes.mu[i] if net.unit_load else nodes.mu[i] * net.normal_load[i]
     else:
         absF = math.sqrt(Fx * Fx + Fy * Fy)
-    return slip_under(net, settings, i, Fx, Fy, absF, absF)
+    return slip(net, settings, i, Fx, Fy, absF, absF)
 
 
-@kernel_jit(inline="always")
-def slip_under(net, settings, i, Fx, Fy, norm, mag):
-    """(ok, du_x, du_y): node i slides from rest under the force (Fx, Fy), the others fixed.
+@kernel_jit(forceinline=True)
+def slip_displacement(net, nodes, settings, i, theta, driving, s):
+    """The straight-line slip of node i (``solver.slip = "straight"``): (True, du_x, du_y)."""
+    return _slip_displacement(net, nodes, settings, i, theta, driving, slip_straight)
 
-    ``settings.slip_mode`` picks the straight line (:func:`straight_slip`,
-    with ``norm`` and ``mag``) or the exact 2D motion (:func:`exact_slip`);
-    ok is False if the exact motion did not come to rest within its step
-    budget. Used by the kernel and by the network tilt test.
-    """
-    fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
-    b = block_of(net, net.diag[i])  # the diagonal block K_ii
+
+@kernel_jit(forceinline=True)
+def slip_displacement_exact(net, nodes, settings, i, theta, driving, s):
+    """The exactly integrated slip of node i (``solver.slip = "exact"``): (ok, du_x, du_y)."""
+    return _slip_displacement(net, nodes, settings, i, theta, driving, slip_exact)
+
+
+@kernel_jit(forceinline=True)
+def _diagonal_block(net, i):
+    """The entries (kxx, kxy, kyy) of node i's diagonal block K_ii."""
+    b = block_of(net, net.diag[i])
     K = net.K_table
-    kxx = K[b, 0, 0]
-    kxy = K[b, 0, 1]
-    kyy = K[b, 1, 1]
-    if settings.slip_mode == SLIP_EXACT:
-        dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
-        return nsteps >= 0, dux, duy
+    return K[b, 0, 0], K[b, 0, 1], K[b, 1, 1]
+
+
+@kernel_jit(forceinline=True)
+def slip_straight(net, settings, i, Fx, Fy, norm, mag):
+    """(True, du_x, du_y): node i slides from rest under the force (Fx, Fy) along a straight line
+    (:func:`straight_slip`, with ``norm`` and ``mag``), the others fixed. Used by the kernel and by
+    the network tilt test."""
+    fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
+    kxx, kxy, kyy = _diagonal_block(net, i)
     dux, duy = straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd)
     return True, dux, duy
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
+def slip_exact(net, settings, i, Fx, Fy, norm, mag):
+    """(ok, du_x, du_y): node i slides from rest under the force (Fx, Fy) by the exact 2D motion
+    (:func:`exact_slip`), the others fixed; ok is False if the motion did not come to rest within
+    its step budget. ``norm`` and ``mag`` are not read (the signature is :func:`slip_straight`'s)."""
+    fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]
+    kxx, kxy, kyy = _diagonal_block(net, i)
+    dux, duy, nsteps = exact_slip(Fx, Fy, kxx, kxy, kyy, fd)
+    return nsteps >= 0, dux, duy
+
+
+@kernel_jit(forceinline=True)
 def block_of(net, p):
     """The row of ``net.K_table`` holding the block of entry p: p itself where every entry has its own.
 
@@ -289,7 +309,7 @@ def block_of(net, p):
     return nonneg(p) if net.block_per_entry else nonneg(net.K_id[nonneg(p)])
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _pushed(net, a, p, j, dux, duy):
     """a_j -= K_ji du_i for the entry p of row i (K is symmetric: K_ji = K_ij, the stored block)."""
     K = net.K_table
@@ -298,17 +318,17 @@ def _pushed(net, a, p, j, dux, duy):
     a[j, 1] -= K[b, 1, 0] * dux + K[b, 1, 1] * duy
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def spread(net, a, i, dux, duy):
     """The forces a_j of node i's neighbours (and its own) after it moved by (dux, duy): a -= K du."""
     for p in range(net.indptr[i], net.indptr[i + 1]):
         _pushed(net, a, p, net.indices[p], dux, duy)
 
 
-@kernel_jit(inline="always")
-def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
+@kernel_jit(forceinline=True)
+def move_node(net, st, nodes, heaps, i, dux, duy, theta):
     """Displace node i by (dux, duy): the centre of mass, and the force offsets on the block row of K,
-    each node of the row re-keyed (``update_node``) as soon as its force is moved."""
+    each node of the row re-keyed (:func:`update_node`) as soon as its force is moved."""
     nodes.u[i, 0] += dux
     nodes.u[i, 1] += duy
     # With unit loads every weight is the same 1/N: w[0], in cache, has the bits of w[i].
@@ -338,12 +358,6 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta, update_node):
         update_node(net, nodes, heaps, j, theta)
 
 
-@kernel_jit(inline="always")
-def pair_force(net, nodes, theta):
-    """The force along x on node 1 (the appendix's tilt test is for 1D pairs; the scene refuses it in 2D)."""
-    return nodes.a[1, 0] + net.g[1, 0] * theta
-
-
 @kernel_jit()
 def stiffness_times(net, u, out):
     """out = K u over the block rows of K (``out`` and ``u`` of shape (N, 2)): the forces' reset."""
@@ -362,9 +376,16 @@ def stiffness_times(net, u, out):
 
 @kernel_jit()
 def run_plane(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
-    """:func:`slidernet.kernels.network.run_network` on a 2D network (``net`` a Plane)."""
+    """:func:`slidernet.kernels.network.run_network` on a 2D network (``net`` a Plane), straight-line slips."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node, pair_force)
+                       update_node, critical_roots, slip_displacement, move_node, no_tilt)
+
+
+@kernel_jit()
+def run_plane_exact(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
+    """:func:`run_plane` with the exactly integrated slip (``solver.slip = "exact"``)."""
+    return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
+                       update_node, critical_roots, slip_displacement_exact, move_node, no_tilt)
 
 
 @kernel_jit()

@@ -18,99 +18,14 @@ offset, as it does a slot of an array: the names cost nothing
 
 from __future__ import annotations
 
-import functools
-import hashlib
-import os
-from collections.abc import Callable
-from pathlib import Path
 from typing import NamedTuple
 
-import numba
 import numpy as np
-import platformdirs
-from numba import njit
 
-try:
-    from numba.core.cpu import CPUTargetOptions
-
-    _NUMBA_HAS_NRT_FLAG = hasattr(CPUTargetOptions, "_nrt")
-except ImportError:  # pragma: no cover - numba moved its internals
-    _NUMBA_HAS_NRT_FLAG = False
+from slidernet.kernels.jit import kernel_jit
 
 
-def kernel_jit(**options) -> Callable:
-    """``numba.njit`` for the kernels: compiled once, cached on disk, no reference counting.
-
-    The kernels never allocate arrays; they only read and write the arrays
-    they are given. With numba's reference counting (NRT) on, every call of
-    a helper that takes arrays increments and decrements each array's count
-    atomically: about 4.5 ns per array per call, measured with numba 0.68,
-    which made the heap bookkeeping of a 2D slip several times slower than
-    its arithmetic. ``_nrt=False`` compiles without it. It is a private
-    numba flag, so a numba that refuses it gets the plain decorator.
-    """
-    if _NUMBA_HAS_NRT_FLAG:
-        options["_nrt"] = False
-    return cached_jit(**options)
-
-
-@functools.cache
-def sources_digest() -> str:
-    """A digest of the kernels' sources (every ``.py`` file of this folder), 16 hex digits.
-
-    numba checks a cached function against its own file only, but a kernel
-    inlines helpers from the other files of this folder: after an edit of
-    ``heap.py`` alone, ``run_plane`` (in ``plane.py``) would load its old
-    machine code, with the old layout of the heaps (a segfault was seen).
-    Each version of the sources therefore gets its own cache folder.
-    """
-    return folder_digest(Path(__file__).parent)
-
-
-def folder_digest(folder: Path) -> str:
-    """16 hex digits of the SHA-1 of the names and contents of the ``.py`` files in ``folder``."""
-    h = hashlib.sha1()
-    for path in sorted(folder.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
-
-
-def cache_dir() -> str:
-    """Where numba keeps slidernet's compiled kernels: a folder per version of their sources.
-
-    Under ``NUMBA_CACHE_DIR`` when the user set it, else under ``numba`` in
-    the per-user cache directory (``platformdirs.user_cache_dir("slidernet")``,
-    e.g. ``~/.cache/slidernet/numba/<sources_digest()>`` on Linux). Never
-    inside the installed package: cache files left in
-    ``site-packages/slidernet/`` by a ``pip install .`` outlive a
-    ``pip uninstall`` and then shadow an editable install as an empty
-    namespace package.
-    """
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
-    return os.path.join(base, sources_digest())
-
-
-def cached_jit(**options) -> Callable:
-    """``numba.njit(cache=True, **options)`` with the cache in :func:`cache_dir`.
-
-    numba picks a function's cache folder when the function is decorated,
-    from ``numba.config.CACHE_DIR``; setting it only for the time of the
-    decoration keeps every other package's numba cache where it was.
-    """
-
-    def decorate(func: Callable) -> Callable:
-        saved = numba.config.CACHE_DIR
-        numba.config.CACHE_DIR = cache_dir()
-        try:
-            return njit(cache=True, **options)(func)
-        finally:
-            numba.config.CACHE_DIR = saved
-
-    return decorate
-
-
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def nonneg(k):
     """The index k (0 <= k < 2**62) with its two top bits cleared: the same value, known to the compiler
     not to be negative, nor k plus a small offset (k + 1, the 8 entries of a tree's group).
@@ -354,13 +269,12 @@ class Plane(NamedTuple):
 
 
 class Settings(NamedTuple):
-    """A run's constants."""
+    """A run's constants. What a kernel does beyond them (the appendix's tilt test, the exact 2D slip) is
+    its compiled variant's (``run_pair_tilt``, ``run_plane_exact``, ...), not a flag read at run time."""
 
     mu_d: float  # dynamic coefficient
     max_slips: int  # slips of one avalanche before AVALANCHE_LIMIT
     recompute_every: int  # slips between recomputations of the forces (0: never)
-    do_tilt: bool  # the appendix's tilt test before every rearrangement (a 1D pair)
-    slip_mode: int  # 2D: SLIP_STRAIGHT (0) or SLIP_EXACT (1)
     # The mean load along x per unit normal load, sum_i f_ext,i,x / sum_i N_i, exceeds mu_d: an
     # avalanche that sets every node in motion is the network sliding away (network kernels). False:
     # the kernels keep no count of the moving nodes at all.

@@ -2,18 +2,11 @@
 
 from __future__ import annotations
 
-from slidernet.kernels.state import (
-    DONE,
-    NEED_TILT,
-    TILT_LIMIT,
-    TILT_MAX_ITER,
-    TILT_NEED_DRAWS,
-    TILT_TOO_LONG,
-    kernel_jit,
-)
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import DONE, NEED_TILT, TILT_LIMIT, TILT_MAX_ITER, TILT_NEED_DRAWS, TILT_TOO_LONG
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def flat_onset(F, mu1, mu2):
     """The slider that starts first on the appendix's substrate, and at which load: (i, f, c).
 
@@ -111,7 +104,7 @@ def tilt_status(f):
     return DONE
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def record_tilt(f, out, k):
     """Add a tilt test's result f to output bin ``k`` (``out.f_sum``, ``f_sq``, ``f_count``); returns
     its :func:`tilt_status` (nothing is recorded unless it is ``DONE``)."""

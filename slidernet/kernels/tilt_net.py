@@ -56,8 +56,9 @@ from __future__ import annotations
 import math
 
 from slidernet.kernels.heap import heap_clear, heap_set
-from slidernet.kernels.plane import slip_under, spread
-from slidernet.kernels.state import TILT_NEED_DRAWS, TILT_TOO_LONG, kernel_jit
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.plane import slip_exact, slip_straight, spread
+from slidernet.kernels.state import TILT_NEED_DRAWS, TILT_TOO_LONG
 
 # Slots of the small integer array ``pos`` (shape (N_POS,)) shared with the caller.
 P_MU = 0  # read position in the threshold buffer
@@ -94,7 +95,7 @@ _UNSTABLE = 0  # unstable nodes keyed by overload
 _CRITICAL = 1  # nodes keyed by minus the tilt f at which they reach their threshold
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _critical_f(Gx, Gy, lim, n):
     """The f >= current at which |(Gx + f n, Gy)| reaches lim (the upper root)."""
     if Gy == 0.0:
@@ -103,7 +104,7 @@ def _critical_f(Gx, Gy, lim, n):
     return (-Gx + math.sqrt(max(r, 0.0))) / n
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _key(j, f, G, mu, normal_load, heaps):
     """Re-key node j in both heaps at tilt f; returns True if it is unstable."""
     n = normal_load[j]
@@ -118,8 +119,9 @@ def _key(j, f, G, mu, normal_load, heaps):
 
 
 @kernel_jit(inline="always")
-def _displacement(net, settings, i, f, driving, G, mu):
-    """(ok, du_x, du_y): node i slips alone under its force plus the tilt f N_i along x.
+def _displacement(net, settings, i, f, driving, G, mu, slip):
+    """(ok, du_x, du_y): node i slips alone under its force plus the tilt f N_i along x, by the rule
+    ``slip`` (:func:`~slidernet.kernels.plane.slip_straight` or :func:`~slidernet.kernels.plane.slip_exact`).
 
     A driving slip starts exactly at the threshold, as on the horizontal substrate.
     """
@@ -127,10 +129,10 @@ def _displacement(net, settings, i, f, driving, G, mu):
     Tx = G[i, 0] + f * n
     Ty = G[i, 1]
     norm = math.sqrt(Tx * Tx + Ty * Ty)
-    return slip_under(net, settings, i, Tx, Ty, norm, mu[i] * n if driving else norm)
+    return slip(net, settings, i, Tx, Ty, norm, mu[i] * n if driving else norm)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps):
     """The appendix's creep rule: both thresholds redrawn, the spring force on slider 2 uniform
     between the values that keep both sliders stable under f. Returns the new read positions."""
@@ -148,10 +150,9 @@ def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
     return p_mu + 2, p_u + 1
 
 
-
-@kernel_jit()
-def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      loads):
+@kernel_jit(inline="always")
+def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch, loads,
+               slip):
     """Raise a uniform tilt on a copy of a network until it slides as a whole.
 
     Parameters
@@ -169,8 +170,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         Block-CSR rows of K (1D padded to 2 x 2 blocks) and the loads N_i; the
         tilt force on node i is f N_i along +x.
     settings : Settings
-        mu_d, slip_mode (0: straight-line slip; 1: exactly integrated 2D
-        slip) and max_slips (give up after this many slips).
+        mu_d and max_slips (give up after this many slips).
     pair_rule : bool
         Use the appendix's creep rule (a 1D pair of sliders).
     tilt_mu, tilt_u : ndarray
@@ -187,6 +187,8 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
         Two heaps over the N nodes (work array).
     epoch : ndarray of int64, shape (N,)
         Work array: the avalanche in which each node last slipped.
+    slip : compiled function
+        The slip rule, ``slip(net, settings, i, Fx, Fy, norm, mag) -> (ok, du_x, du_y)``.
     loads : ndarray of float64, shape (N_LOADS,)
         Out: the load f + f_bar at the test's first slip (``L_FIRST``), and
         when an avalanche first set every node in motion at once, above mu_d
@@ -280,7 +282,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
                 pending -= 1
             epoch[i] = ep
             moved += 1
-        ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu)
+        ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu, slip)
         if not ok:
             return _give_up(pos, loads, f, STOP_SLIP_MOTION)
         spread(net, G, i, dux, duy)
@@ -313,7 +315,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
             pending = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _sample(pos, loads, f, p_mu, p_u, load):
     """End the test with a sample, the load f + f_bar: the read positions after its draws, and f."""
     loads[L_F] = f
@@ -323,7 +325,7 @@ def _sample(pos, loads, f, p_mu, p_u, load):
     return load
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _give_up(pos, loads, f, why):
     """End the test without a sample (``TILT_TOO_LONG``); ``why`` goes to ``pos[STOP]``, f to ``loads[L_F]``."""
     loads[L_F] = f
@@ -332,7 +334,7 @@ def _give_up(pos, loads, f, why):
     return TILT_TOO_LONG
 
 
-@kernel_jit(inline="always")
+@kernel_jit(forceinline=True)
 def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moved, pending, av_slips):
     """Keep where the test stands, to resume at ``stage`` once the buffers are longer."""
     pos[P_MU] = p_mu
@@ -346,3 +348,20 @@ def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moved, pendin
     pos[S_AV] = av_slips
     loads[L_F] = f
     return TILT_NEED_DRAWS
+
+
+@kernel_jit()
+def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
+                      loads):
+    """The network tilt test with straight-line slips (1D networks, and 2D with ``solver.slip = "straight"``):
+    :func:`_tilt_test`, whose docstring gives the parameters."""
+    return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
+                      loads, slip_straight)
+
+
+@kernel_jit()
+def tilt_test_network_exact(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps,
+                            epoch, loads):
+    """The network tilt test with the exactly integrated 2D slip (``solver.slip = "exact"``)."""
+    return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
+                      loads, slip_exact)

@@ -35,7 +35,7 @@ import numpy as np
 
 from slidernet._validation import check_scalar
 from slidernet.errors import ConfigError, param_error
-from slidernet.kernels.state import cached_jit
+from slidernet.kernels.jit import cached_jit
 
 
 class GaussianSteps:

@@ -25,8 +25,10 @@ Backends:
 - :class:`ChainBackend` (``csr``): any 1D network, CSR rows of K;
 - :class:`PlaneBackend` (``vec``): any 2D network, 2 x 2 blocks of K.
 
-The two network backends run the same kernel, :func:`slidernet.kernels.run_network`,
-on their operators (:class:`~slidernet.kernels.Chain` or :class:`~slidernet.kernels.Plane`).
+The two network backends run the same driving loop, :func:`slidernet.kernels.network.run_network`,
+on their operators (:class:`~slidernet.kernels.Chain` or :class:`~slidernet.kernels.Plane`). Each
+backend picks its kernel's compiled variant once, from the scene (the appendix's tilt test
+before every rearrangement, the exact 2D slip), so that nothing else is compiled.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.errors import SnapshotError
-from slidernet.solver.scene import EVENT_CHUNK, Scene
+from slidernet.solver.scene import EVENT_CHUNK, SLIP_EXACT, Scene
 from slidernet.solver.snapshot import take
 
 
@@ -71,6 +73,12 @@ class PairBackend:
 
     def __init__(self, scene: Scene, real: Host) -> None:
         self.scene = scene
+        self._run = kernels.run_pair_tilt if scene.do_tilt else kernels.run_pair
+
+    @staticmethod
+    def parts(scene: Scene) -> list[str]:
+        """What this backend compiles for ``scene``, in words (the compile notice's list)."""
+        return ["pair", "pair tilt test"] if scene.do_tilt else ["pair"]
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         """Records this kernel writes beyond every scene's (none)."""
@@ -78,8 +86,7 @@ class PairBackend:
 
     def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
-        return kernels.run_pair(thetas, scene.out_steps, real.mu, real.state, real.buffers, real.series,
-                                scene.settings())
+        return self._run(thetas, scene.out_steps, real.mu, real.state, real.buffers, real.series, scene.settings())
 
     def forces(self, real: Host) -> np.ndarray:
         st = real.state[0]
@@ -148,8 +155,8 @@ class NetworkBackend:
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {"mu_mean": np.zeros(T), "mu_min": np.zeros(T)}
 
-    # The compiled kernel of the network's geometry, and the one that builds its heaps.
-    _run: ClassVar[Callable[..., int]]
+    # The compiled kernel of the network's geometry and the scene's variant, and the one that builds its heaps.
+    _run: Callable[..., int]
     _init_heaps: ClassVar[Callable[..., None]]
 
     def rebuild_heaps(self, real: Host) -> None:
@@ -157,7 +164,7 @@ class NetworkBackend:
 
     def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
-        return type(self)._run(thetas, scene.out_steps, scene.operators, real.state, self.nodes, self.heaps,
+        return self._run(thetas, scene.out_steps, scene.operators, real.state, self.nodes, self.heaps,
                                real.buffers, self.catalogue, real.series, scene.settings())
 
     def forces(self, real: Host) -> np.ndarray:
@@ -279,8 +286,16 @@ class ChainBackend(NetworkBackend):
     """Any 1D network (``solver.kernel = "csr"``): CSR rows of K, scalar forces."""
 
     kernel: ClassVar[str] = "csr"
-    _run = kernels.run_chain
     _init_heaps = kernels.init_chain_heaps
+
+    def __init__(self, scene: Scene, real: Host) -> None:
+        self._run = kernels.run_chain_tilt if scene.do_tilt else kernels.run_chain
+        super().__init__(scene, real)
+
+    @staticmethod
+    def parts(scene: Scene) -> list[str]:
+        """What this backend compiles for ``scene``, in words (the compile notice's list)."""
+        return ["1D network", "appendix's tilt test"] if scene.do_tilt else ["1D network"]
 
 
 class PlaneBackend(NetworkBackend):
@@ -288,8 +303,16 @@ class PlaneBackend(NetworkBackend):
     along y too."""
 
     kernel: ClassVar[str] = "vec"
-    _run = kernels.run_plane
     _init_heaps = kernels.init_plane_heaps
+
+    def __init__(self, scene: Scene, real: Host) -> None:
+        self._run = kernels.run_plane_exact if scene.slip_mode == SLIP_EXACT else kernels.run_plane
+        super().__init__(scene, real)
+
+    @staticmethod
+    def parts(scene: Scene) -> list[str]:
+        """What this backend compiles for ``scene``, in words (the compile notice's list)."""
+        return ["2D network", "exact 2D slip"] if scene.slip_mode == SLIP_EXACT else ["2D network"]
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {**super().records(T), "y_G": np.zeros(T)}

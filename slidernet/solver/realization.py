@@ -246,8 +246,8 @@ class Realization:
         cap = tilt_avalanche_cap(N)
         while True:
             buffers = self.buffers
-            f = tilt_net.tilt_test_network(G, mu, o.f_ext, o.f_bar, o.net, settings, o.pair_rule, buffers.tilt_mu,
-                                           buffers.tilt_u, pos, cap, heaps, epoch, loads)
+            f = o.test(G, mu, o.f_ext, o.f_bar, o.net, settings, o.pair_rule, buffers.tilt_mu, buffers.tilt_u, pos,
+                       cap, heaps, epoch, loads)
             status = kernels.tilt_status(f)
             if status == kernels.DONE:
                 st["tilt_mu_pos"], st["tilt_u_pos"] = pos[tilt_net.P_MU], pos[tilt_net.P_U]

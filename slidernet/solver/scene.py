@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -10,7 +11,7 @@ import scipy.sparse as sp
 
 from slidernet.config import Config, build_network, choose_kernel, choose_tilt_at
 from slidernet.errors import ConfigError
-from slidernet.kernels import Chain, Plane, Settings
+from slidernet.kernels import Chain, Plane, Settings, tilt_net
 from slidernet.kernels.assembly import diagonal_positions
 from slidernet.model.network import Network, pair_tilt_applies
 from slidernet.solver.creep import CreepSpec, reference_slip
@@ -102,6 +103,11 @@ def stiffness_matrix(operators: Chain | Plane) -> sp.csr_matrix | sp.bsr_matrix:
                          shape=(2 * n, 2 * n))
 
 
+# Scene.slip_mode: the 2D slip along a straight line, or the exactly integrated 2D motion (solver.slip).
+SLIP_STRAIGHT = 0
+SLIP_EXACT = 1
+
+
 class TiltOperators(NamedTuple):
     """What the network tilt test runs on (:func:`slidernet.kernels.tilt_net.tilt_test_network`)."""
 
@@ -109,6 +115,7 @@ class TiltOperators(NamedTuple):
     f_ext: np.ndarray  # (N, 2) external forces, in N
     f_bar: float  # sum_i f_ext,i,x / sum_i N_i
     pair_rule: bool  # the appendix's creep rule applies (a 1D pair)
+    test: Callable[..., float]  # the compiled test of the scene's slip rule (tilt_test_network or its _exact)
 
 
 @dataclass
@@ -144,7 +151,7 @@ class Scene:
     max_avalanche: int
     batch: int
     recompute_every: int
-    slip_mode: int
+    slip_mode: int  # SLIP_STRAIGHT or SLIP_EXACT (solver.slip)
     catalogue: bool = False  # the kernel keeps the event catalogue (for 'events' or 'creep')
     tilt_loads: bool = False  # the network tilt tests record their loads at the first slip and collective motion
     max_events: int = 0
@@ -171,14 +178,13 @@ class Scene:
     def tilt_operators(self) -> TiltOperators:
         """The operators of the network tilt test (built on first use; 1D padded to 2D)."""
         if self._tilt_operators is None:
-            self._tilt_operators = _tilt_operators(self.network, self.operators)
+            self._tilt_operators = _tilt_operators(self.network, self.operators, self.slip_mode)
         return self._tilt_operators
 
     def settings(self) -> Settings:
         """The run's constants, as the kernels take them."""
         return Settings(mu_d=float(self.mu_d), max_slips=int(self.max_avalanche),
-                        recompute_every=int(self.recompute_every), do_tilt=bool(self.do_tilt),
-                        slip_mode=int(self.slip_mode), slide_away=bool(self.slide_away))
+                        recompute_every=int(self.recompute_every), slide_away=bool(self.slide_away))
 
     @classmethod
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
@@ -214,7 +220,7 @@ class Scene:
             max_avalanche=cfg.solver.max_avalanche,
             batch=cfg.solver.batch,
             recompute_every=cfg.solver.recompute_every,
-            slip_mode=1 if cfg.solver.slip == "exact" else 0,
+            slip_mode=SLIP_EXACT if cfg.solver.slip == "exact" else SLIP_STRAIGHT,
             catalogue=catalogue,
             max_events=cfg.solver.max_events,
             keep_events="events" in cfg.observables,
@@ -255,9 +261,10 @@ def mean_load(net: Network) -> float:
     return float(net.f_ext[:, 0].sum() / net.normal_load.sum())
 
 
-def _tilt_operators(net: Network, operators: Chain | Plane) -> TiltOperators:
+def _tilt_operators(net: Network, operators: Chain | Plane, slip_mode: int) -> TiltOperators:
     """K's block rows with 2 x 2 blocks for the network tilt test: in 2D the scene's own, in 1D
-    padded with zeros; no thermal load (the test holds theta fixed)."""
+    padded with zeros; no thermal load (the test holds theta fixed). The test's compiled variant
+    follows the slip rule: 1D slips are straight lines."""
     d = net.dim
     N = net.n_nodes
     normal_load = net.normal_load.astype(np.float64)
@@ -271,8 +278,8 @@ def _tilt_operators(net: Network, operators: Chain | Plane) -> TiltOperators:
                        normal_load / normal_load.sum(), bool((normal_load == 1.0).all()))
     f_ext = np.zeros((N, 2))
     f_ext[:, :d] = net.f_ext
-    return TiltOperators(net=plane, f_ext=f_ext, f_bar=mean_load(net),
-                         pair_rule=N == 2 and d == 1)
+    test = tilt_net.tilt_test_network_exact if slip_mode == SLIP_EXACT else tilt_net.tilt_test_network
+    return TiltOperators(net=plane, f_ext=f_ext, f_bar=mean_load(net), pair_rule=N == 2 and d == 1, test=test)
 
 
 def tilt_avalanche_cap(n_nodes: int) -> int:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from slidernet.kernels.state import kernel_jit
+from slidernet.kernels.jit import kernel_jit
 
 OUT_OF_DRAWS = -1
 AVALANCHE_LIMIT = -2

@@ -51,7 +51,8 @@ from slidernet.analysis.trend import log_trend
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import TiltTestError, param_error
-from slidernet.kernels.state import DONE, NEED_MU, TILT_MAX_ITER, kernel_jit
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import DONE, NEED_MU, TILT_MAX_ITER
 from slidernet.kernels.tilt import record_tilt, tilt_iterations, tilt_test_pair
 from slidernet.solver import Realization, Scene
 
@@ -60,7 +61,8 @@ _AFTER = {"threshold": False, "after": True, "incline": False, "incline_after": 
 _INCLINE = {"threshold": False, "after": False, "incline": True, "incline_after": True}
 LN10 = math.log(10.0)
 
-@kernel_jit(inline="always")
+
+@kernel_jit(forceinline=True)
 def incline_onset(F, mu1, mu2):
     """The slider that starts first on an exact incline: (i, tan(alpha_i), cos(alpha_i)).
 
