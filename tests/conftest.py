@@ -57,10 +57,17 @@ def pytest_configure(config: pytest.Config) -> None:
     if not parts:
         return
     t0 = time.perf_counter()
+    # Said at once: pytest prints nothing of its own until the workers have started.
+    print(f"slidernet: compiling the kernels for the tests ({' and '.join(parts)} parts side by side), once "
+          f"per installation: about {_WARM_SECONDS} s on a 2-core machine; the tests start after.",
+          file=sys.stderr, flush=True)
     script = Path(__file__).with_name("warm_kernels.py")
     procs = {part: subprocess.Popen([sys.executable, str(script), part], stdout=subprocess.PIPE,
                                     stderr=subprocess.STDOUT, text=True) for part in parts}
-    outputs = {part: proc.communicate()[0] for part, proc in procs.items()}
+    outputs = {}
+    for part, proc in procs.items():
+        outputs[part] = proc.communicate()[0]
+        print(f"slidernet: {part} kernels compiled ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
     note = f"kernels compiled before the workers started: {', '.join(parts)} in {time.perf_counter() - t0:.0f} s"
     failed = [f"{part}: {(outputs[part].strip().splitlines() or ['no output'])[-1]}"
               for part, proc in procs.items() if proc.returncode != 0]
@@ -70,6 +77,8 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 _WARM_NOTE = pytest.StashKey[str]()
+# Wall seconds of the warm-up from an empty cache on the idle 2-core dev machine (2026-11-27).
+_WARM_SECONDS = 60
 
 
 def pytest_report_header(config: pytest.Config) -> str | None:

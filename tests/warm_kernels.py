@@ -20,39 +20,43 @@ from typing import Any
 import numpy as np
 
 from slidernet.config import load_config
-from slidernet.solver import Realization, Scene
+from slidernet.solver.compile import compile_kernels
 
 _FRICTION = {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}}
 _DRIVER = {"name": "gaussian_steps", "sigma_theta": 1e-7}
+_MU_EFF = ["n", "mu_max", "x_G", "mu_eff"]
 
 
-def _scene(network: dict[str, Any], **extra: Any) -> Scene:
-    cfg = {"seed": 1, "realizations": 1, "steps": 4, "record": [0, 2, 4], "network": {"Ntilde": 1e-7, **network},
+def _compile(network: dict[str, Any], **extra: Any) -> None:
+    """Every kernel of the scene, through the solver's own probe (slidernet.solver.compile)."""
+    cfg = {"seed": 1, "realizations": 1, "steps": 4, "network": {"Ntilde": 1e-7, **network},
            "friction": _FRICTION, "driver": _DRIVER, **extra}
-    return Scene.from_config(load_config(cfg))
-
-
-def _advance(network: dict[str, Any], **extra: Any) -> None:
-    Realization(_scene(network, **extra), np.random.SeedSequence(1)).advance()
+    compile_kernels(load_config(cfg), notice=None)
 
 
 def _pair() -> None:
-    _advance({"kind": "two_slider"}, observables=["n", "mu_max", "x_G", "mu_eff"])
+    _compile({"kind": "two_slider"})
+    _compile({"kind": "two_slider"}, observables=_MU_EFF)
 
 
 def _pair_csr() -> None:
-    _advance({"kind": "two_slider"}, solver={"kernel": "csr"})
+    _compile({"kind": "two_slider"}, solver={"kernel": "csr"})
+    _compile({"kind": "two_slider"}, solver={"kernel": "csr"}, observables=_MU_EFF)
 
 
 def _chain() -> None:
-    _advance({"kind": "chain", "n": 6}, observables=["n", "mu_max", "x_G", "mu_eff"])
+    _compile({"kind": "chain", "n": 6}, observables=_MU_EFF)
 
 
 def _pair_validation() -> None:
+    from slidernet.solver import Scene
     from slidernet.validation import tilt_readings
     from slidernet.validation.speed_error import fixed_step_final
 
-    fixed_step_final(_scene({"kind": "two_slider"}), [np.random.SeedSequence(1)], 1.0)
+    scene = Scene.from_config(load_config({"seed": 1, "realizations": 1, "steps": 4,
+                                           "network": {"kind": "two_slider", "Ntilde": 1e-7},
+                                           "friction": _FRICTION, "driver": _DRIVER}))
+    fixed_step_final(scene, [np.random.SeedSequence(1)], 1.0)
     tilt_readings.readings(tilt_readings.case_config(0.5, 10.0, 4, 1, 1))
 
 
@@ -63,19 +67,19 @@ def _ou_driver() -> None:
 
 
 def _lattice() -> None:
-    _advance({"kind": "triangular", "shape": [4, 4]}, observables=["n", "mu_max", "x_G", "mu_eff"])
+    _compile({"kind": "triangular", "shape": [4, 4]}, observables=_MU_EFF)
 
 
 def _lattice_exact() -> None:
-    _advance({"kind": "square", "shape": [4, 4]}, solver={"slip": "exact", "recompute_every": 1})
+    _compile({"kind": "square", "shape": [4, 4]}, solver={"slip": "exact", "recompute_every": 1},
+             observables=_MU_EFF)
 
 
 def _irregular() -> None:
-    _advance({"kind": "irregular", "n": 64, "seed": 0}, observables=["n", "mu_max", "x_G", "mu_eff"])
+    _compile({"kind": "irregular", "n": 64, "seed": 0}, observables=_MU_EFF)
 
 
-#: The 1D kernels and the validation's, and the 2D ones (the 2D part alone: 139 s of CPU on the dev machine,
-#: another job beside it).
+#: The 1D kernels and the validation's, and the 2D ones.
 PARTS: dict[str, list[Callable[[], None]]] = {
     "1d": [_pair, _pair_csr, _chain, _pair_validation, _ou_driver],
     "2d": [_lattice, _lattice_exact, _irregular],

@@ -85,6 +85,16 @@ def scene_of(config_json: str):
 _WORKER_STOP: Any = None
 
 
+@functools.lru_cache(maxsize=4)
+def _compiled(config_json: str) -> None:
+    """The scene's kernels in a Dask worker, compiled once per process and once per machine: the first
+    worker of a machine holds the cache's lock and compiles, the others wait and load from the cache."""
+    from slidernet.config import load_config
+    from slidernet.solver.compile import compile_kernels
+
+    compile_kernels(load_config(json.loads(config_json)), notice=None)
+
+
 class StopSignal:
     """Ctrl-C (SIGINT) and SIGTERM during a run, as a context manager.
 
@@ -272,6 +282,8 @@ def _task(*args: Any) -> tuple[Record, list[tuple[type[Warning], str]]]:
     Without a Dask Event's name among ``args``, the stop is the pool worker's flag.
     """
     stop = args[6] if len(args) > 6 else (None if _WORKER_STOP is None else _WORKER_STOP.is_set)
+    if len(args) > 6:
+        _compiled(args[0])  # a Dask worker: a local pool's workers are forked from a parent that compiled
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         record = run_realization(*args[:6], stop=stop)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import signal
+import sys
 import time
 import warnings
 from collections.abc import Callable, Mapping
@@ -22,6 +23,7 @@ from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import CheckpointError, RunInterrupted, SlidAwayWarning, param_error
 from slidernet.io import read_result
 from slidernet.io.store import RunStore
+from slidernet.solver.compile import compile_kernels
 
 
 def resolve_seed(cfg: Config) -> Config:
@@ -43,16 +45,30 @@ def identity(requested: Config, resolved: Config) -> dict[str, Any]:
             "slidernet_version": __version__}
 
 
-def _attrs(cfg: Config, kernel: str, workers: int, scheduler: str | None) -> dict[str, str]:
-    return {
+#: What each value of a scene's ``tilt_at`` measures: the ``mu_eff_estimator`` attribute of a result.
+MU_EFF_ESTIMATORS = {
+    "rearrangements": "the appendix's virtual tilt test of the two sliders, made before every rearrangement "
+                      "(and once at t = 0) and pooled over each bin (t_{k-1}, t_k]",
+    "records": "the network tilt test (a uniform tilt raised on a copy of the network until it slides as a "
+               "whole), made once per realization at each recorded time t",
+}
+
+
+def _attrs(cfg: Config, scene: Any, workers: int, scheduler: str | None) -> dict[str, str]:
+    attrs = {
         "config": json.dumps(cfg.model_dump(mode="json", exclude={"execution"}), sort_keys=True),
         "execution": json.dumps({"workers": workers, "scheduler": scheduler}),
         "slidernet_version": __version__,
         "seed": str(cfg.seed),
-        "kernel": kernel,
+        "kernel": scene.kernel,
         "Conventions": "CF-1.8",
         "title": "slidernet result",
     }
+    if scene.tilt_at is not None:
+        # mu_eff_at = "auto" resolves per network: the result says which test it holds.
+        attrs["mu_eff_at"] = scene.tilt_at
+        attrs["mu_eff_estimator"] = MU_EFF_ESTIMATORS[scene.tilt_at]
+    return attrs
 
 
 def run(
@@ -108,7 +124,10 @@ def run(
         Variables ``n``, ``mu_max``, ``x_G`` (realization, t) and ``mu_eff``
         (t) as requested, with ensemble means and standard errors; attributes
         ``config`` (the resolved configuration as JSON), ``slidernet_version``,
-        ``seed``, ``kernel`` and ``execution``.
+        ``seed``, ``kernel`` and ``execution``; with ``mu_eff``, also
+        ``mu_eff_at`` (``"rearrangements"`` or ``"records"``, what
+        ``mu_eff_at = "auto"`` resolved to) and ``mu_eff_estimator`` (the
+        test in words).
 
     Raises
     ------
@@ -170,7 +189,7 @@ def run(
         if store is not None:
             store.abandon()  # a run that failed before saving anything leaves the folder as it found it
         raise
-    attrs = _attrs(cfg, scene.kernel, workers, scheduler)
+    attrs = _attrs(cfg, scene, workers, scheduler)
     if store is None:
         ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
     else:
@@ -219,6 +238,10 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
         partial = None if store is None else str(store.partial(r))
         return config_json, cfg.seed, r, partial, ex.checkpoint_every, meta
 
+    if pending:
+        # In this process, before any worker starts: forked workers inherit the compiled kernels, and
+        # the others load them from the cache instead of each compiling them again.
+        compile_kernels(cfg, notice=_stderr if _shows_progress(progress) else None)
     bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
@@ -247,6 +270,15 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
     if store is not None:
         store.flush()
     return records
+
+
+def _shows_progress(progress: bool | None) -> bool:
+    """tqdm's rule for ``disable=None``: progress is shown on a terminal."""
+    return bool(progress) if progress is not None else sys.stderr.isatty()
+
+
+def _stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
 
 
 def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:

@@ -439,13 +439,22 @@ def sweep(
     }
     if len(set(kernels)) > 1:
         ds.attrs["kernels"] = json.dumps(kernels)
+    tilt_at = [r.attrs.get("mu_eff_at") for r in results]
+    if any(tilt_at):
+        # mu_eff_at = "auto" may resolve differently from point to point (the pair against a network).
+        ds.attrs["mu_eff_at"] = ", ".join(dict.fromkeys(a for a in tilt_at if a))
+        ds.attrs["mu_eff_estimator"] = "; ".join(dict.fromkeys(r.attrs["mu_eff_estimator"] for r in results
+                                                               if "mu_eff_estimator" in r.attrs))
+        if len(set(tilt_at)) > 1:
+            ds.attrs["mu_eff_at_points"] = json.dumps(tilt_at)
     if "execution" in results[-1].attrs:
         ds.attrs["execution"] = results[-1].attrs["execution"]
     result: xr.Dataset | xr.DataTree = ds
     if split_nodes:
         for i, group in enumerate(groups):
             group.attrs = {"sweep_point": i, "sweep_assignment": json.dumps(points[i]),
-                           "config": results[i].attrs["config"], "kernel": kernels[i]}
+                           "config": results[i].attrs["config"], "kernel": kernels[i],
+                           **({"mu_eff_at": tilt_at[i]} if tilt_at[i] else {})}
         result = xr.DataTree.from_dict({"/": ds, **{f"point_{i}": g for i, g in enumerate(groups)}})
     if folder is not None:
         write_netcdf(result, folder / "result.nc")

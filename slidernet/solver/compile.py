@@ -1,0 +1,148 @@
+"""Compile a scene's kernels before its realizations run: once per machine, said on the terminal.
+
+numba compiles a kernel the first time it is called with a new type
+signature and keeps the machine code in its disk cache
+(:mod:`slidernet.kernels.jit`). Left to itself, each worker process of a
+run would compile the same kernels at the same time, and nothing would say
+why a first run is slow. :func:`compile_kernels` instead runs a *probe*
+before the realizations start: the same scene, shrunk to a few nodes and
+two thermal steps (:func:`probe_config`). It calls exactly the compiled
+functions the real scene calls, with the same type signatures (the types
+of the arrays do not depend on their sizes), so the real run compiles
+nothing more. It holds the cache's lock of its kernels while it runs: the
+processes of one machine compile them once, and the others load them from
+the cache. Forked workers inherit what the parent compiled.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from slidernet.config import Config, load_config
+from slidernet.errors import SlidernetError
+from slidernet.kernels.jit import cache_dir, compile_lock, on_first_compile
+from slidernet.plugins import registry
+from slidernet.solver.backends import BACKENDS
+from slidernet.solver.realization import Realization
+from slidernet.solver.scene import Scene
+
+# The largest probe: enough nodes that every code path of the kernels is typed, few enough to cost nothing.
+_PROBE_CHAIN = 8
+_PROBE_IRREGULAR = 32
+_PROBE_SIDE = 4
+_PROBE_SLIPS = 2000
+
+# CPU seconds to compile each part from an empty cache, one process, on the project's 2-core dev machine
+# (2026-11-27, `python benchmarks/cold_start.py`); the notice's estimate is their sum.
+_COMPILE_SECONDS = {
+    "pair": 3.5,
+    "pair tilt test": 1.5,
+    "1D network": 11.0,
+    "appendix's tilt test": 1.5,
+    "2D network": 12.5,
+    "exact 2D slip": 2.0,
+    "network tilt test": 7.0,
+}
+
+
+def probe_config(cfg: Config) -> Config | None:
+    """The scene of ``cfg`` shrunk to a few nodes, one realization and two thermal steps.
+
+    Only the size changes (a chain of at most 8 sliders, a lattice of at
+    most 4 x 4, an irregular network of at most 32; a graph read from a file
+    is kept whole), ``solver.max_avalanche`` (2000 slips), and a plugin that
+    is not a built-in, replaced by a built-in of its kind (a Gaussian law, a
+    driver of Gaussian steps), so the probe runs the same compiled kernels as
+    ``cfg``, stops soon, and never calls a user's plugin.
+    None if the shrunk configuration is not valid (a rule that needs more
+    steps): the real run then compiles what it needs as it goes.
+    """
+    data = cfg.model_dump(mode="json", exclude={"execution"})
+    data.update(seed=0, realizations=1, steps=2, record="all")
+    # A plugin of the user's runs only in the real run: its sample() or thetas() may count, log or read a
+    # finite source. What the kernels compile does not depend on it (float64 arrays either way); a
+    # built-in is kept, since some compile code of their own (compiled draws, the OU recursion).
+    friction = data["friction"]
+    if registry.distributions.origin(friction["static"]["name"]) != "built-in":
+        friction["static"] = {"name": "gaussian", "mean": friction["mu_d"] + 0.1, "std": 0.01}
+    if registry.drivers.origin(data["driver"]["name"]) != "built-in":
+        data["driver"] = {"name": "gaussian_steps", "sigma_theta": 1e-7}
+    # A bound on the work of one avalanche and of one tilt test: a probe that reaches it stops with an error
+    # (which it drops) after its kernels have run, instead of following a long test (a square lattice's
+    # floppy rows slide alone for 1e5 slips before the tilt test gives up, each an integration with the
+    # exact 2D slip).
+    data["solver"] = {**data.get("solver", {}), "max_avalanche": _PROBE_SLIPS}
+    net = data["network"]
+    if net["kind"] == "chain" and net["n"] > _PROBE_CHAIN:
+        net["n"] = _PROBE_CHAIN
+    elif net["kind"] == "irregular" and net["n"] > _PROBE_IRREGULAR:
+        net["n"] = _PROBE_IRREGULAR
+    elif net["kind"] in ("square", "triangular"):
+        rows, cols = net["shape"]
+        net["shape"] = [min(rows, _PROBE_SIDE), min(cols, _PROBE_SIDE)]
+    try:
+        return load_config(data)
+    except SlidernetError:
+        return None
+
+
+def kernel_parts(scene: Scene) -> list[str]:
+    """What a scene compiles, in words: its kernel and the variants it needs (the notice's list)."""
+    parts = BACKENDS[scene.kernel].parts(scene)
+    if scene.tilt_at == "records":
+        parts.append("network tilt test")
+    return parts
+
+
+def compile_notice(scene: Scene) -> str:
+    """The line a first run prints before it compiles: what, that it happens once, about how long."""
+    parts = kernel_parts(scene)
+    seconds = sum(_COMPILE_SECONDS[p] for p in parts)
+    return (f"slidernet: compiling the kernels of this scene ({', '.join(parts)}) for this machine, once per "
+            f"installation: about {seconds:.0f} s of CPU on a small machine; later runs load them from "
+            f"{cache_dir()}.")
+
+
+def _stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def compile_kernels(cfg: Config, notice: Callable[[str], Any] | None = _stderr) -> bool:
+    """Compile (or load from the cache) every kernel the scene of ``cfg`` runs; True if anything was compiled.
+
+    Parameters
+    ----------
+    cfg : Config
+        The run's configuration.
+    notice : callable or None
+        Called with :func:`compile_notice`'s line once, when numba starts
+        compiling (not when everything loads from the cache); None: silent.
+        Default: print it on stderr.
+
+    An error of the probe itself (a network the probe's size cannot hold,
+    say) is not the run's: it is left for the real run to meet, and
+    whatever the probe compiled before it stays compiled.
+    """
+    probe = probe_config(cfg)
+    if probe is None:
+        return False
+    try:
+        scene = Scene.from_config(probe)
+    except SlidernetError:
+        return False
+    line = compile_notice(scene)
+
+    def said() -> None:
+        if notice is not None:
+            notice(line)
+
+    with compile_lock(", ".join(kernel_parts(scene))), on_first_compile(said) as compiled:
+        try:
+            Realization(scene, np.random.SeedSequence(0)).advance()
+        except SlidernetError:
+            pass
+    return compiled.compiled
