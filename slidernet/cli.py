@@ -9,7 +9,7 @@
 ``slidernet paper [--quick] --out DIR``   reproduces the paper's four result figures (Figs. 2-5)
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
-``slidernet plugins``                     lists the registered plugins, where they come from
+``slidernet plugins [--plugin FILE.py]``  lists the registered plugins, where they come from
 ``slidernet units --material steel --size 0.1 --delta-T 0.01``
                                           Ntilde, sigma_theta and tau_th of a physical setup
 
@@ -47,6 +47,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--out", type=Path, required=True, help="output directory")
     _progress_flag(r)
     _execution_flags(r)
+    _plugin_flag(r)
 
     sw = sub.add_parser(
         "sweep", help="run a grid of parameters; write DIR/result.nc with the swept parameters as dimensions",
@@ -59,6 +60,7 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--out", type=Path, required=True, help="output directory")
     _progress_flag(sw)
     _execution_flags(sw)
+    _plugin_flag(sw)
 
     pl = sub.add_parser(
         "plot", help="draw the standard panels of a result: n, mu_max, <x_G^2>, mu_eff against t, with the "
@@ -97,7 +99,8 @@ def _parser() -> argparse.ArgumentParser:
     se.add_argument("--quick", action="store_true", help="small preset (under 3 minutes)")
     _progress_flag(se)
 
-    sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
+    pg = sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
+    _plugin_flag(pg)
 
     from slidernet.model.units import MATERIALS
 
@@ -140,17 +143,48 @@ def _execution_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace a finished result in --out")
 
 
+def _plugin_flag(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--plugin", dest="plugins", action="append", metavar="FILE.py|MODULE",
+                   help="a Python file or a dotted module name that registers distributions or drivers when "
+                        "imported; appended to the configuration's 'plugins' (repeatable; a path is relative "
+                        "to the current directory)")
+
+
+def _with_cli_plugins(config: Path, plugins: list[str] | None) -> Path | dict:
+    """The configuration file, read, with the ``--plugin`` entries added to its ``plugins``; as is without any.
+
+    The entries go into the configuration itself, not only into this
+    process, so that the workers, which load the configuration again,
+    import them too, and the result's ``config`` attribute lists them.
+    """
+    if not plugins:
+        return config
+    from slidernet.config import read_toml
+    from slidernet.plugins.loader import absolute_entry
+
+    source = read_toml(config)
+    listed = source.get("plugins", [])
+    if not isinstance(listed, list):  # refused, by name, when the configuration is validated
+        return source
+    cwd = Path.cwd()
+    added = [absolute_entry(entry, cwd) for entry in plugins]
+    source["plugins"] = listed + [entry for entry in dict.fromkeys(added) if entry not in listed]
+    return source
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
     from slidernet.ensemble.runner import all_slid_away, run
 
-    cfg = load_config(args.config)  # validate before any work or any file
+    cfg = load_config(_with_cli_plugins(args.config, args.plugins))  # validate before any work or any file
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SlidAwayWarning)  # said below, once, as a line of its own
         ds = run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
                  scheduler=args.scheduler, overwrite=args.overwrite, scheduler_timeout=args.scheduler_timeout)
     with ds:
         print(f"wrote {args.out / 'result.nc'} (seed {ds.attrs['seed']}, kernel {ds.attrs['kernel']})")
+        if "mu_eff_estimator" in ds.attrs:
+            print(f"mu_eff: {ds.attrs['mu_eff_estimator']} (mu_eff_at = {ds.attrs['mu_eff_at']!r})")
         slid = all_slid_away(ds)
         if slid is not None:
             print(f"slidernet: {slid}")
@@ -162,7 +196,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
     from slidernet.ensemble.sweep import parse_grid, sweep
 
-    result = sweep(args.config, parse_grid(args.sets), progress=_progress(args), out=args.out,
+    result = sweep(_with_cli_plugins(args.config, args.plugins), parse_grid(args.sets),
+                   progress=_progress(args), out=args.out,
                    resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                    scheduler_timeout=args.scheduler_timeout)
     # The points differ in number of nodes: the stacked variables are at the tree's root.
@@ -233,6 +268,10 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
     from slidernet.plugins import registry
+    from slidernet.plugins.loader import absolute_entry, import_plugins
+
+    # So that a physicist can see their file register its names before naming them in a configuration.
+    import_plugins([absolute_entry(entry, Path.cwd()) for entry in args.plugins or ()], field="--plugin option")
 
     for reg in (registry.distributions, registry.drivers):
         print(f"{reg.kind}s ({reg.group}):")

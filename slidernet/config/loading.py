@@ -1,9 +1,10 @@
 """Loading a configuration: from a TOML file or a dict to a validated :class:`Config` with its plugins built.
 
-Every check happens here, before any work: structure and ranges through
-pydantic, plugin names and parameters by building the plugins, and the
-checks that need them built (an incline steeper than every threshold, a
-driver too short for the run). Pydantic's errors are rewritten as one
+Every check happens here, before any work: the files and modules of
+``plugins`` imported first (so that what they register can be named),
+structure and ranges through pydantic, plugin names and parameters by
+building the plugins, and the checks that need them built (an incline
+steeper than every threshold, a driver too short for the run). Pydantic's errors are rewritten as one
 :class:`~slidernet.errors.ConfigError` that names each field and the
 reason.
 """
@@ -21,6 +22,7 @@ from pydantic import ValidationError
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
 from slidernet.model.network import Network
+from slidernet.plugins.loader import absolute_entry, import_plugins
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -59,7 +61,9 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     """A configuration file as a dict, not validated; relative file paths made relative to the file.
 
     Files named in a config file (a graph, a temperature series, measured
-    thresholds) are found next to that file.
+    thresholds, the ``.py`` files of ``plugins``) are found next to that
+    file. A plugin file's path is made absolute, so that a worker that
+    starts elsewhere (Dask) imports the same file.
     """
     path = Path(path)
     try:
@@ -76,17 +80,26 @@ def read_toml(path: str | Path) -> dict[str, Any]:
             named = Path(table["path"])
             if not named.is_absolute():
                 table["path"] = str(path.parent / named)
+    plugins = source.get("plugins")
+    if isinstance(plugins, list):  # anything else is refused, by name, when it is validated
+        source["plugins"] = [absolute_entry(e, path.parent) if isinstance(e, str) else e for e in plugins]
     return source
 
 
 def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     """Validate a configuration and build its plugins.
 
+    The files and modules listed under ``plugins`` are imported first, in
+    order (once per process), so that the distributions and drivers they
+    register are known when the configuration names them.
+
     Parameters
     ----------
     source : Config, mapping, or path
         A :class:`Config`, a dict with the keys of docs/model.md section 5, or the
-        path of a TOML file with those keys.
+        path of a TOML file with those keys. A relative path under ``plugins``
+        is relative to the TOML file, or for a dict or a Config to the current
+        directory; a dict's is stored absolute.
 
     Returns
     -------
@@ -96,15 +109,18 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     Raises
     ------
     ConfigError
-        On any invalid field; the message names the field and the reason.
+        On any invalid field, or a ``plugins`` entry that cannot be imported;
+        the message names the field and the reason.
     """
     if isinstance(source, (str, Path)):
         source = read_toml(source)
     if isinstance(source, Config):
+        import_plugins(source.plugins or ())
         cfg = source
     else:
         if not isinstance(source, Mapping):
             raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
+        source = _import_listed_plugins(source)
         try:
             cfg = Config.model_validate(dict(source))
         except ValidationError as exc:
@@ -123,6 +139,23 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
         except ConfigError as exc:
             raise ConfigError(f"The 'driver' field: {exc}") from None
     return cfg
+
+
+def _import_listed_plugins(source: Mapping[str, Any]) -> Mapping[str, Any]:
+    """Import the ``plugins`` of a raw configuration before it is validated; return it with their paths absolute.
+
+    Before validation, because the validators already look plugin names up
+    (whether the driver takes ``sigma_theta``, for ``[units]``). A value that
+    is not a list of strings is left to the validation, which names it.
+    """
+    plugins = source.get("plugins")
+    if not (isinstance(plugins, list) and all(isinstance(e, str) and e for e in plugins)):
+        return source
+    cwd = Path.cwd()
+    # Absolute in the stored configuration: workers that start in another folder find the same files.
+    absolute = [absolute_entry(e, cwd) for e in plugins]
+    import_plugins(absolute)
+    return {**source, "plugins": absolute}
 
 
 def _check_incline_holds(cfg: Config) -> None:

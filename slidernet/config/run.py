@@ -55,7 +55,9 @@ class Config(_Strict):
     standard deviation of the temperature, where they are not given.
     """
 
-    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep",)
+    # "plugins" too: a configuration without it dumps as it did before the key existed, so that
+    # stored results and interrupted runs (run.json) still match it.
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins")
 
     seed: Annotated[int, Field(ge=0)] | None = Field(
         None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
@@ -89,6 +91,13 @@ class Config(_Strict):
     creep: CreepConfig | None = Field(
         None, description="Parameters of the observable 'creep' (the reptation velocity and the creep events); "
                           "None: the defaults. Refused without that observable.")
+    plugins: list[Annotated[str, Field(min_length=1)]] | None = Field(
+        None, description="Python files (ending in .py; a relative path is relative to the configuration file) "
+                          "or dotted module names that register plugins when imported "
+                          "(slidernet.register_distribution, register_driver): imported in order, once per "
+                          "process, before the names of [friction.static] and [driver] are looked up. Every "
+                          "worker imports them again, so a file must be at the same path where the workers "
+                          "run. None: none.")
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)

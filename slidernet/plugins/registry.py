@@ -23,6 +23,9 @@ from slidernet.errors import UnknownPluginError
 
 Factory = Callable[..., Any]
 
+#: The function that registers a name of each kind at run time, as the unknown-name error names it.
+_REGISTER_FUNCTIONS = {"distribution": "slidernet.register_distribution", "driver": "slidernet.register_driver"}
+
 
 class Registry:
     """A name -> factory mapping, backed by an entry-point group.
@@ -33,28 +36,42 @@ class Registry:
         The entry-point group searched for third-party plugins.
     kind : str
         Human-readable name of what is registered, used in error messages.
-    builtins : dict of str to callable
-        The factories that ship with slidernet.
+    builtins : dict of str to callable, or a callable that returns one
+        The factories that ship with slidernet; a callable is called on the
+        first lookup, so that importing slidernet imports no plugin module
+        (nor scipy.stats, which some of them need).
 
     Examples
     --------
     >>> reg = Registry("slidernet.examples", "example", {"one": lambda: 1})
     >>> reg.get("one")()
     1
-    >>> reg.get("two")
+    >>> reg.get("two")  # doctest: +NORMALIZE_WHITESPACE
     Traceback (most recent call last):
     ...
-    slidernet.errors.UnknownPluginError: Unknown example 'two'. Available: 'one'.
+    slidernet.errors.UnknownPluginError: Unknown example 'two'. Available: 'one'. To add one, install a
+    package that declares it as an entry point of the group 'slidernet.examples', list the Python file or
+    module that registers it under plugins = [...] in the configuration or with --plugin on the command
+    line, or call Registry.register(name, factory) in Python.
     """
 
-    def __init__(self, group: str, kind: str, builtins: dict[str, Factory]) -> None:
+    def __init__(self, group: str, kind: str,
+                 builtins: dict[str, Factory] | Callable[[], dict[str, Factory]]) -> None:
         self.group = group
         self.kind = kind
-        self._builtins = dict(builtins)
+        self._builtin_source = builtins
+        self._builtin_factories: dict[str, Factory] | None = None
         self._runtime: dict[str, Factory] = {}
         self._entry_points: dict[str, EntryPoint] | None = None
         self._loaded: dict[str, Factory] = {}
         self._errors: dict[str, str] = {}
+
+    @property
+    def _builtins(self) -> dict[str, Factory]:
+        if self._builtin_factories is None:
+            source = self._builtin_source
+            self._builtin_factories = dict(source() if callable(source) else source)
+        return self._builtin_factories
 
     def _discover(self) -> dict[str, EntryPoint]:
         if self._entry_points is None:
@@ -79,7 +96,8 @@ class Registry:
         Raises
         ------
         UnknownPluginError
-            If no plugin has that name; the message lists the available ones.
+            If no plugin has that name; the message lists the available ones and
+            the ways to add one.
         """
         if name in self._runtime:
             return self._runtime[name]
@@ -101,8 +119,18 @@ class Registry:
             else:
                 self._loaded[name] = factory
                 return factory
+        raise self._unknown(name)
+
+    def _unknown(self, name: str) -> UnknownPluginError:
+        """The error for a name no plugin has: the names there are, and the ways to add one."""
         available = ", ".join(repr(n) for n in self.names())
-        raise UnknownPluginError(f"Unknown {self.kind} {name!r}. Available: {available}.")
+        register = _REGISTER_FUNCTIONS.get(self.kind, "Registry.register")
+        return UnknownPluginError(
+            f"Unknown {self.kind} {name!r}. Available: {available}. To add one, install a package that "
+            f"declares it as an entry point of the group {self.group!r}, list the Python file or module that "
+            f"registers it under plugins = [...] in the configuration or with --plugin on the command line, "
+            f"or call {register}(name, factory) in Python."
+        )
 
     def load_error(self, name: str) -> str | None:
         """Why the entry point ``name`` failed to load (its target and exception), or None."""
@@ -120,8 +148,7 @@ class Registry:
             return "built-in"
         ep = self._discover().get(name)
         if ep is None:
-            available = ", ".join(repr(n) for n in self.names())
-            raise UnknownPluginError(f"Unknown {self.kind} {name!r}. Available: {available}.")
+            raise self._unknown(name)
         dist = getattr(ep, "dist", None)
         return f"{dist.name} {dist.version}" if dist is not None else f"entry point {ep.value}"
 
@@ -148,8 +175,8 @@ def _builtin_drivers() -> dict[str, Factory]:
     return BUILTINS
 
 
-distributions = Registry("slidernet.distributions", "distribution", _builtin_distributions())
-drivers = Registry("slidernet.drivers", "driver", _builtin_drivers())
+distributions = Registry("slidernet.distributions", "distribution", _builtin_distributions)
+drivers = Registry("slidernet.drivers", "driver", _builtin_drivers)
 
 
 def register_distribution(name: str, factory: Factory) -> None:
