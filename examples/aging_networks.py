@@ -369,16 +369,19 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     mech = data["mechanism"]
     labels = [f"{m['kind'][:5]} {m['n']}" for m in mech]
     x = np.arange(len(mech))
+    # Four markers per network, grouped about its tick; the limits keep a lone network in the middle
+    # (with one network, the autoscaled axis spread the markers over the whole width).
     for k, (label, key) in enumerate((("t = 0", "t0"), ("end", "end"))):
-        ax_m.errorbar(x + 0.1 * k, [m[f"mu_s_shift_{key}_mean"] for m in mech],
+        ax_m.errorbar(x - 0.15 + 0.1 * k, [m[f"mu_s_shift_{key}_mean"] for m in mech],
                       yerr=[m[f"mu_s_shift_{key}_sem"] for m in mech], fmt="o", color=f"C{k}",
                       label=r"$\langle\mu_s\rangle - $ law mean, " + label)
     ax_m.axhline(0, color="k", lw=0.6)
     ax_m.set_xticks(x, labels, fontsize=8)
+    ax_m.set_xlim(-0.5, len(mech) - 0.5)
     ax_m.set_ylabel("threshold shift (selection)")
     ax_r = ax_m.twinx()
     for k, (label, key) in enumerate((("t = 0", "t0"), ("end", "end"))):
-        ax_r.errorbar(x + 0.2 + 0.1 * k, [m[f"load_ratio_{key}_mean"] for m in mech],
+        ax_r.errorbar(x + 0.05 + 0.1 * k, [m[f"load_ratio_{key}_mean"] for m in mech],
                       yerr=[m[f"load_ratio_{key}_sem"] for m in mech], fmt="s", color=f"C{k + 2}",
                       label=r"load ratio $|F|/(\mu_s N)$, " + label)
     ax_r.set_ylabel("mean load ratio (prestress)")
