@@ -76,11 +76,12 @@ def _parser() -> argparse.ArgumentParser:
                     help="show the figure in a window instead of writing it (with --out: both)")
 
     paper_help = ("reproduce the four result figures of Geminard & Bertin (2010), its Figs. 2-5, written as "
-                  "fig1_* to fig4_*; a full run took 72-77 s on 2 cores and "
-                  "0.91 GB of memory in all (measured on a 2-core machine, 2026-11-25)")
+                  "fig1_* to fig4_*; a full run took 102 s of wall time (183 s of CPU) and 0.90 GB of memory "
+                  "in all on an idle 2-core machine, kernels compiled (2026-11-27)")
     pp = sub.add_parser("paper", help=paper_help, description=paper_help[0].upper() + paper_help[1:] + ".")
     pp.add_argument("--out", type=Path, required=True, help="output directory")
-    pp.add_argument("--quick", action="store_true", help="small preset (under 2 minutes)")
+    pp.add_argument("--quick", action="store_true",
+                    help="small preset (10 s of wall time, 12.5 s of CPU on an idle 2-core machine)")
     _progress_flag(pp)
     pp.add_argument("--resume", action="store_true",
                     help="continue an interrupted reproduction in --out: finished runs are read back, the "

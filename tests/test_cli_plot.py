@@ -104,7 +104,7 @@ def test_paper_help_states_the_time_and_memory_of_a_full_run(capsys):
     with pytest.raises(SystemExit):
         slidernet.cli.main(["paper", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
-    assert "72-77 s on 2 cores" in help_text and "0.91 GB" in help_text
+    assert "102 s of wall time (183 s of CPU)" in help_text and "0.90 GB" in help_text
 
 
 # --------------------------------------------------------------------------

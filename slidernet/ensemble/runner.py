@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import signal
-import sys
 import time
 import warnings
 from collections.abc import Callable, Mapping
@@ -23,7 +22,7 @@ from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import CheckpointError, RunInterrupted, SlidAwayWarning, param_error
 from slidernet.io import read_result
 from slidernet.io.store import RunStore
-from slidernet.solver.compile import compile_kernels
+from slidernet.solver.compile import compile_kernels, terminal_notice
 
 
 def resolve_seed(cfg: Config) -> Config:
@@ -241,7 +240,7 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
     if pending:
         # In this process, before any worker starts: forked workers inherit the compiled kernels, and
         # the others load them from the cache instead of each compiling them again.
-        compile_kernels(cfg, notice=_stderr if _shows_progress(progress) else None)
+        compile_kernels(cfg, notice=terminal_notice(progress))
     bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
@@ -270,15 +269,6 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
     if store is not None:
         store.flush()
     return records
-
-
-def _shows_progress(progress: bool | None) -> bool:
-    """tqdm's rule for ``disable=None``: progress is shown on a terminal."""
-    return bool(progress) if progress is not None else sys.stderr.isatty()
-
-
-def _stderr(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:

@@ -17,7 +17,7 @@ the cache. Forked workers inherit what the parent compiled.
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -98,11 +98,12 @@ def kernel_parts(scene: Scene) -> list[str]:
     return parts
 
 
-def compile_notice(scene: Scene) -> str:
+def compile_notice(scenes: Scene | Sequence[Scene]) -> str:
     """The line a first run prints before it compiles: what, that it happens once, about how long."""
-    parts = kernel_parts(scene)
+    parts = list(dict.fromkeys(p for scene in ([scenes] if isinstance(scenes, Scene) else scenes)
+                               for p in kernel_parts(scene)))
     seconds = sum(_COMPILE_SECONDS[p] for p in parts)
-    return (f"slidernet: compiling the kernels of this scene ({', '.join(parts)}) for this machine, once per "
+    return (f"slidernet: compiling the kernels this run needs ({', '.join(parts)}) for this machine, once per "
             f"installation: about {seconds:.0f} s of CPU on a small machine; later runs load them from "
             f"{cache_dir()}.")
 
@@ -111,38 +112,54 @@ def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
-def compile_kernels(cfg: Config, notice: Callable[[str], Any] | None = _stderr) -> bool:
-    """Compile (or load from the cache) every kernel the scene of ``cfg`` runs; True if anything was compiled.
+def terminal_notice(progress: bool | None) -> Callable[[str], None] | None:
+    """Where a caller with a progress flag says that it compiles: stderr where its bar would show (tqdm's
+    rule: ``None`` means only on a terminal), nowhere otherwise."""
+    shown = bool(progress) if progress is not None else sys.stderr.isatty()
+    return _stderr if shown else None
+
+
+def compile_kernels(configs: Config | Sequence[Config], notice: Callable[[str], Any] | None = _stderr) -> bool:
+    """Compile (or load from the cache) every kernel the scene of each configuration runs; True if anything
+    was compiled.
 
     Parameters
     ----------
-    cfg : Config
-        The run's configuration.
+    configs : Config or sequence of Config
+        The run's configuration, or those of several runs (a study, the
+        paper's figures): one probe per distinct set of kernels.
     notice : callable or None
-        Called with :func:`compile_notice`'s line once, when numba starts
-        compiling (not when everything loads from the cache); None: silent.
-        Default: print it on stderr.
+        Called with :func:`compile_notice`'s line, for all the scenes
+        together, once, when numba starts compiling (not when everything
+        loads from the cache); None: silent. Default: print it on stderr.
 
-    An error of the probe itself (a network the probe's size cannot hold,
+    An error of a probe itself (a network the probe's size cannot hold,
     say) is not the run's: it is left for the real run to meet, and
     whatever the probe compiled before it stays compiled.
     """
-    probe = probe_config(cfg)
-    if probe is None:
+    scenes: dict[tuple[str, ...], Scene] = {}
+    for cfg in [configs] if isinstance(configs, Config) else configs:
+        probe = probe_config(cfg)
+        if probe is None:
+            continue
+        try:
+            scene = Scene.from_config(probe)
+        except SlidernetError:
+            continue
+        scenes.setdefault((*kernel_parts(scene), cfg.friction.static.name, cfg.driver.name), scene)
+    if not scenes:
         return False
-    try:
-        scene = Scene.from_config(probe)
-    except SlidernetError:
-        return False
-    line = compile_notice(scene)
+    line = compile_notice(list(scenes.values()))
 
     def said() -> None:
         if notice is not None:
             notice(line)
 
-    with compile_lock(", ".join(kernel_parts(scene))), on_first_compile(said) as compiled:
-        try:
-            Realization(scene, np.random.SeedSequence(0)).advance()
-        except SlidernetError:
-            pass
+    with on_first_compile(said) as compiled:
+        for scene in scenes.values():
+            with compile_lock(", ".join(kernel_parts(scene))):
+                try:
+                    Realization(scene, np.random.SeedSequence(0)).advance()
+                except SlidernetError:
+                    pass
     return compiled.compiled
