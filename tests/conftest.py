@@ -67,7 +67,8 @@ def pytest_configure(config: pytest.Config) -> None:
     outputs = {}
     for part, proc in procs.items():
         outputs[part] = proc.communicate()[0]
-        print(f"slidernet: {part} kernels compiled ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+        print(f"slidernet: {part} kernels compiled ({time.perf_counter() - t0:.0f} s)", file=sys.stderr,
+              flush=True)
     note = f"kernels compiled before the workers started: {', '.join(parts)} in {time.perf_counter() - t0:.0f} s"
     failed = [f"{part}: {(outputs[part].strip().splitlines() or ['no output'])[-1]}"
               for part, proc in procs.items() if proc.returncode != 0]
