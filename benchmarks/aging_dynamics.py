@@ -57,7 +57,7 @@ from slidernet.analysis.trend import log_trend, mean_sem
 from slidernet.config import load_config
 from slidernet.ensemble.runner import realization_seeds
 from slidernet.errors import TiltTestError
-from slidernet.kernels.tilt_net import N_LOADS, N_POS, N_SLIPS, tilt_test_network
+from slidernet.kernels.tilt_net import N_LOADS, N_POS, N_SLIPS
 from slidernet.plugins.distributions.stream import TruncatedStream
 from slidernet.solver import Scene
 from slidernet.solver.scene import tilt_avalanche_cap
@@ -104,9 +104,9 @@ def qs_tilt(scene: Scene, F: np.ndarray, mu_s: np.ndarray, seed: int, key: tuple
         G[:, 0] = F
         pos = np.zeros(N_POS, np.int64)
         loads = np.zeros(N_LOADS)
-        f = tilt_test_network(G, mu_s.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
-                              stream.take(size), uniforms, pos, tilt_avalanche_cap(N), kernels.Heaps.empty(2, N),
-                              np.zeros(N, np.int64), loads)
+        f = o.test(G, mu_s.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
+                   stream.take(size), uniforms, pos, tilt_avalanche_cap(N), kernels.Heaps.empty(2, N),
+                   np.zeros(N, np.int64), np.zeros(N, np.int64), loads)
         status = kernels.tilt_status(f)
         if status == kernels.DONE:
             return float(f)

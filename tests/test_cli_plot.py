@@ -255,3 +255,13 @@ def test_show_draws_in_a_pyplot_figure_and_writes_nothing(results, monkeypatch, 
     assert shown == [4]
     assert capsys.readouterr().out == ""
     assert not png.exists()
+
+
+def test_the_laws_of_the_papers_slip_are_not_drawn_for_another_overshoot(results):
+    ds = read_result(results["pair"])
+    cfg = result_config(ds)
+    cfg["friction"]["overshoot"] = 0.5
+    overlays = theory_overlays(ds, load_config(cfg))
+    for key in ("n", "x_G2"):
+        assert overlays[key].values is None and "friction.overshoot = 1" in overlays[key].reason
+    assert overlays["mu_max_exact"].values is not None  # the law of the max of n + 2 draws does not use the slip

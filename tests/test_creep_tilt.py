@@ -45,14 +45,14 @@ def network_tilt_on_pair(F, mu1, mu2, mu_d, tmu, tu):
     heaps, epoch, pos = _pair_work()
     f = tilt_test_network(G, np.array([mu1, mu2]), ops.f_ext, ops.f_bar, ops.net, _settings(mu_d, 10_000),
                           ops.pair_rule, np.asarray(tmu, float), np.asarray(tu, float), pos, 10_000, heaps, epoch,
-                          np.zeros(N_LOADS))
+                          np.zeros(2, np.int64), np.zeros(N_LOADS))
     return f, int(pos[P_MU]), int(pos[P_U])
 
 
 def pair_tilt(F, mu1, mu2, mu_d, tmu, tu):
     st = kernels.new_state()[0]
     f = kernels.tilt_test_pair(st, kernels.Draws(np.empty(0), np.asarray(tmu, float), np.asarray(tu, float)),
-                               F, mu1, mu2, mu_d)
+                               F, mu1, mu2, mu_d, 2.0)
     return f, int(st["tilt_mu_pos"]), int(st["tilt_u_pos"])
 
 
@@ -95,7 +95,8 @@ def test_network_tilt_out_of_draws_asks_for_more_and_rolls_back():
     heaps, epoch, pos = _pair_work()
     pos[P_MU], pos[P_U] = 3, 1
     f = tilt_test_network(np.zeros((2, 2)), np.array([0.6, 0.9]), ops.f_ext, 0.0, ops.net, _settings(0.5, 100),
-                          True, np.full(3, 0.7), np.full(1, 0.5), pos, 100, heaps, epoch, np.zeros(N_LOADS))
+                          True, np.full(3, 0.7), np.full(1, 0.5), pos, 100, heaps, epoch, np.zeros(2, np.int64),
+                          np.zeros(N_LOADS))
     assert f == -1.0
     assert (pos[P_MU], pos[P_U]) == (3, 1)
 

@@ -43,9 +43,9 @@ class PairState:
                                   n_records=np.zeros(T, np.int64), mu_mean=nothing, mu_min=nothing, y_G=nothing,
                                   f_sum=np.zeros(T), f_sq=np.zeros(T), f_count=np.zeros(T, np.int64))
 
-    def run(self, thetas, mu_buf, mu_d: float = MU_D) -> int:
+    def run(self, thetas, mu_buf, mu_d: float = MU_D, slip_factor: float = 2.0) -> int:
         draws = kernels.Draws(np.asarray(mu_buf, dtype=float), np.empty(0), np.empty(0))
-        settings = kernels.Settings(mu_d=mu_d, max_slips=1000, recompute_every=0)
+        settings = kernels.Settings(mu_d=mu_d, max_slips=1000, recompute_every=0, slip_factor=slip_factor)
         return kernels.run_pair(np.asarray(thetas, dtype=float), self.out_steps, self.mu, self.state, draws,
                                 self.out, settings)
 
@@ -216,7 +216,7 @@ def tilt_reference(F, mu1, mu2, mu_d, tmu, tu):
 def run_tilt(F, mu1, mu2, mu_d, tmu, tu):
     st = kernels.new_state()[0]
     f = kernels.tilt_test_pair(st, kernels.Draws(np.empty(0), np.asarray(tmu, float), np.asarray(tu, float)),
-                               F, mu1, mu2, mu_d)
+                               F, mu1, mu2, mu_d, 2.0)
     return f, int(st["tilt_mu_pos"]), int(st["tilt_u_pos"])
 
 
@@ -260,7 +260,7 @@ def test_tilt_out_of_draws_rolls_back():
     st["tilt_mu_pos"] = 3
     st["tilt_u_pos"] = 2
     draws = kernels.Draws(np.empty(0), np.full(3, 0.7), np.full(2, 0.5))
-    f = kernels.tilt_test_pair(st, draws, 0.0, 0.6, 0.9, 0.5)
+    f = kernels.tilt_test_pair(st, draws, 0.0, 0.6, 0.9, 0.5, 2.0)
     assert f == -1.0
     assert (st["tilt_mu_pos"], st["tilt_u_pos"]) == (3, 2)
 
@@ -269,8 +269,8 @@ def test_tilt_iteration_cap():
     # Thresholds exactly at mu_d and F redrawn at the centre give f = mu_d
     # forever (creep without end): the kernel gives up with -2.
     m = kernels.TILT_MAX_ITER
-    f = kernels.tilt_test_pair(kernels.new_state()[0], kernels.Draws(np.empty(0), np.full(2 * m + 2, 0.5),
-                                                                      np.full(m + 1, 0.5)), 0.0, 0.5, 0.5, 0.5)
+    draws = kernels.Draws(np.empty(0), np.full(2 * m + 2, 0.5), np.full(m + 1, 0.5))
+    f = kernels.tilt_test_pair(kernels.new_state()[0], draws, 0.0, 0.5, 0.5, 0.5, 2.0)
     assert f == -2.0
 
 

@@ -95,7 +95,7 @@ def test_without_spring_force_incline_and_linear_tests_agree(mu1, mu2):
     """With F = 0 a test that ends at its first onset gives the same tilt on the incline: tan(alpha) = min mu."""
     _, r1 = _record()
     _, r2 = _record()
-    lin = tilt_test_pair(r1, _draws([], []), 0.0, mu1, mu2, 0.5)
+    lin = tilt_test_pair(r1, _draws([], []), 0.0, mu1, mu2, 0.5, 2.0)
     inc = tilt_test_incline(r2, _draws([], []), 0.0, mu1, mu2, 0.5)
     assume(lin > 0)  # -1: the test needed draws (a slider rearranged first, F no longer 0)
     assert inc == pytest.approx(lin, rel=1e-12)
@@ -108,7 +108,7 @@ def test_the_incline_weighs_the_spring_force_more():
     _, r2 = _record()
     draws = _draws([], [])
     # Slider 2 pulled back (F < 0) by 0.08, slider 1 pushed: both thresholds 0.6, mu_d = 0.5.
-    lin = tilt_test_pair(r1, draws, -0.08, 0.6, 0.6, 0.5)
+    lin = tilt_test_pair(r1, draws, -0.08, 0.6, 0.6, 0.5, 2.0)
     inc = tilt_test_incline(r2, draws, -0.08, 0.6, 0.6, 0.5)
     assert lin == pytest.approx(0.52)  # slider 1 first, at f = mu1 + F
     assert inc < lin  # -0.08 / cos(alpha) pulls harder: slider 1 starts earlier

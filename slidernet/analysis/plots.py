@@ -523,8 +523,11 @@ def theory_overlays(ds: xr.Dataset, config: Config | None = None) -> dict[str, O
     mu_d = cfg.friction.mu_d
     dist = cfg.distribution()
 
+    paper_slip = cfg.friction.slip_factor() == 2.0  # the laws of n and x_G rest on the paper's slip length
     if not gaussian_steps:
         skip("n", "gaussian_steps driver only")
+    elif not paper_slip:
+        skip("n", "the paper's slip only (friction.overshoot = 1)")
     else:
         try:
             r_slope = float(theory.mean_rearrangements(sigma_theta, cfg.network.Ntilde, mu_d,
@@ -557,6 +560,8 @@ def theory_overlays(ds: xr.Dataset, config: Config | None = None) -> dict[str, O
 
     if not gaussian_steps:
         skip("x_G2", "gaussian_steps driver only")
+    elif not paper_slip:
+        skip("x_G2", "the paper's slip only (friction.overshoot = 1)")
     elif n_typical is None:
         skip("x_G2", "needs n")
     else:

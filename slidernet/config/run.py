@@ -26,6 +26,7 @@ from slidernet.config.plugins import (
 )
 from slidernet.config.rules import choose_kernel, choose_tilt_at
 from slidernet.config.solver import SolverConfig
+from slidernet.config.tilt import TiltConfig
 from slidernet.config.units import _UNITS_RTOL, UnitsConfig, _fill_from_units
 from slidernet.model.builders import KIND_DIMS
 from slidernet.plugins import registry
@@ -57,7 +58,7 @@ class Config(_Strict):
 
     # "plugins" too: a configuration without it dumps as it did before the key existed, so that
     # stored results and interrupted runs (run.json) still match it.
-    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins")
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
 
     seed: Annotated[int, Field(ge=0)] | None = Field(
         None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
@@ -88,6 +89,9 @@ class Config(_Strict):
     execution: ExecutionConfig = Field(
         default_factory=ExecutionConfig,
         description="Where the realizations run; never changes a result, and not part of a run's identity.")
+    tilt: TiltConfig | None = Field(
+        None, description="The sliding rule of the network tilt test (mu_eff at the recorded times); None: "
+                          "one avalanche above mu_d in which every node slips, the rule of every earlier result.")
     creep: CreepConfig | None = Field(
         None, description="Parameters of the observable 'creep' (the reptation velocity and the creep events); "
                           "None: the defaults. Refused without that observable.")
@@ -161,6 +165,18 @@ class Config(_Strict):
                                                                self.network.pair_tilt_applies()) != "records":
             raise ValueError("the 'tilt_loads' observable is read from the network tilt test at the recorded "
                              "times: set 'mu_eff_at = \"records\"'")
+        if self.tilt is not None and not self.tilt.is_default():
+            if "mu_eff" not in self.observables:
+                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test of 'mu_eff', "
+                                 "which is not asked for; add \"mu_eff\" to 'observables' or remove the table")
+            if choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies()) != "records":
+                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test, and this run's "
+                                 "mu_eff is the appendix's test before every rearrangement: set "
+                                 "'mu_eff_at = \"records\"'")
+        if self.friction.slip_factor() != 2.0 and self.solver.slip == "exact":
+            raise ValueError("'friction.overshoot' sets the length of a straight-line slip, and 'solver.slip = "
+                             "\"exact\"' integrates the undamped 2D motion, whose overshoot is 1; use one or the "
+                             "other")
         if self.creep is not None and "creep" not in self.observables:
             raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
                              "add \"creep\" to 'observables' or remove the table")
@@ -200,6 +216,10 @@ class Config(_Strict):
     def needs_catalogue(self) -> bool:
         """True if the kernel keeps the event catalogue: for the observable 'events', or 'creep' (read from it)."""
         return "events" in self.observables or "creep" in self.observables
+
+    def tilt_settings(self) -> TiltConfig:
+        """The [tilt] table, or its defaults where it is not given."""
+        return self.tilt if self.tilt is not None else TiltConfig()
 
     def creep_settings(self) -> CreepConfig:
         """The [creep] table, or its defaults where it is not given."""

@@ -50,9 +50,10 @@ def critical_roots(net, nodes, j):
 
 @kernel_jit(forceinline=True)
 def slip_displacement(net, nodes, settings, i, theta, driving, s):
-    """The slip of node i alone, an undamped half-oscillation: (True, du, 0.0).
+    """The slip of node i alone: (True, du, 0.0).
 
-    Delta u_i = 2 (|F_i| - mu_d N_i) sign(F_i) / K_ii (eq. `displacement`).
+    Delta u_i = (1 + e) (|F_i| - mu_d N_i) sign(F_i) / K_ii, e = friction.overshoot
+    (``settings.slip_factor`` = 1 + e; e = 1: the undamped half-oscillation of eq. `displacement`).
     A driving slip (``driving``, theta moving with sign s) starts exactly at
     the threshold, |F_i| = mu_s,i N_i, with the sign of g_i s.
     """
@@ -63,7 +64,7 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
         F = nodes.a[i] + net.g[i] * theta
         absF = abs(F)
     sgn = 1.0 if F > 0.0 else -1.0
-    return True, 2.0 * (absF - settings.mu_d * net.normal_load[i]) * sgn / net.K_diag[i], 0.0
+    return True, settings.slip_factor * (absF - settings.mu_d * net.normal_load[i]) * sgn / net.K_diag[i], 0.0
 
 
 @kernel_jit(forceinline=True)
@@ -90,7 +91,8 @@ def pair_tilt(net, st, nodes, draws, out, settings):
     The spring force on node 1, F_{1->2}, is what the test reads.
     """
     F = nodes.a[1] + net.g[1] * st.theta
-    return tilt_sample(st, draws, out, st.next_out, F, nodes.mu[0], nodes.mu[1], settings.mu_d)
+    return tilt_sample(st, draws, out, st.next_out, F, nodes.mu[0], nodes.mu[1], settings.mu_d,
+                       settings.slip_factor)
 
 
 @kernel_jit()

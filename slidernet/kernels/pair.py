@@ -12,9 +12,9 @@ from slidernet.kernels.tilt import tilt_sample
 def _most_overloaded(F, mu0, mu1):
     """The slider that slips next in an avalanche under spring force F: (i, F_i), i = -1 if both are stable.
 
-    Largest overload first, ties to the lowest index. With two sliders an
-    avalanche needs mu_min > 3 mu_d (the slipped slider overshoots past its
-    new threshold).
+    Largest overload first, ties to the lowest index. With two sliders and the
+    paper's slip an avalanche needs mu_min > 3 mu_d (the slipped slider
+    overshoots past its new threshold).
     """
     aF = abs(F)
     un0 = aF > mu0 * 1.0
@@ -27,7 +27,7 @@ def _most_overloaded(F, mu0, mu1):
 
 
 @kernel_jit(forceinline=True)
-def no_tilt(st, draws, out, k, F, mu1, mu2, mu_d):
+def no_tilt(st, draws, out, k, F, mu1, mu2, mu_d, sf):
     """The ``tilt`` of :func:`run_pair`: no test, DONE (LLVM folds the call away)."""
     return DONE
 
@@ -54,15 +54,18 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
     units). The hot state is held in local scalars and written back to
     ``state[0]`` on exit. ``out`` is a :class:`~slidernet.kernels.state.Series`
     without ``mu_mean``, ``mu_min`` and ``y_G``. ``tilt(st, draws, out, k, F,
-    mu1, mu2, mu_d)`` is :func:`~slidernet.kernels.tilt.tilt_sample` (the
-    appendix's test before every rearrangement) or :func:`no_tilt`.
+    mu1, mu2, mu_d, sf)`` is :func:`~slidernet.kernels.tilt.tilt_sample` (the
+    appendix's test before every rearrangement) or :func:`no_tilt`. A slip
+    is ``c = settings.slip_factor`` times (|F| - mu_d) long (c = 2: the
+    paper's eq. `displacement`).
     """
     st = state[0]
     mu_d = settings.mu_d
+    c = settings.slip_factor
     max_slips = settings.max_slips
     steps = thetas.size - 1
     if st.started == 0:
-        status = tilt(st, draws, out, st.next_out, st.theta - st.u, mu[0], mu[1], mu_d)
+        status = tilt(st, draws, out, st.next_out, st.theta - st.u, mu[0], mu[1], mu_d, c)
         if status != DONE:
             return status
         if out_steps[st.next_out] == 0:
@@ -104,7 +107,7 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
                 av -= 1
                 status = NEED_MU
                 break
-            status = tilt(st, draws, out, k, F, mu0, mu1, mu_d)
+            status = tilt(st, draws, out, k, F, mu0, mu1, mu_d, c)
             if status != DONE:
                 av -= 1
                 break
@@ -138,8 +141,8 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
                 vt = s * theta
                 vb = s * theta_b
                 xr = s * xg
-                d0 = 2.0 * (mu0 * 1.0 - mu_d * 1.0)
-                d1 = 2.0 * (mu1 * 1.0 - mu_d * 1.0)
+                d0 = c * (mu0 * 1.0 - mu_d * 1.0)
+                d1 = c * (mu1 * 1.0 - mu_d * 1.0)
                 while True:
                     one = mu1 < mu0
                     tc = (mu1 if one else mu0) * 1.0 + v
@@ -154,7 +157,7 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
                         status = NEED_MU
                         break
                     # F = theta_c - u, exactly s (tc - v).
-                    status = tilt(st, draws, out, k, s * (tc - v), mu0, mu1, mu_d)
+                    status = tilt(st, draws, out, k, s * (tc - v), mu0, mu1, mu_d, c)
                     if status != DONE:
                         break
                     d = d1 if one else d0
@@ -163,7 +166,7 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
                     new = mu_draws[nonneg(p)]
                     p += 1
                     nrec += new > mumax
-                    d_new = 2.0 * (new * 1.0 - mu_d * 1.0)
+                    d_new = c * (new * 1.0 - mu_d * 1.0)
                     mu1 = new if one else mu1
                     mu0 = mu0 if one else new
                     d1 = d_new if one else d1
@@ -197,7 +200,7 @@ def _run_pair(thetas, out_steps, mu, state, draws, out, settings, tilt):
             continue
         # Slider i slips alone (eq. `displacement`); its threshold is redrawn.
         sgn = 1.0 if Fi > 0.0 else -1.0
-        du = 2.0 * (aFi - mu_d * 1.0) * sgn / 1.0
+        du = c * (aFi - mu_d * 1.0) * sgn / 1.0
         if i == 1:
             u = u + du
         else:

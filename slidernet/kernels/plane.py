@@ -211,8 +211,10 @@ def critical_roots(net, nodes, j):
 
 
 @kernel_jit(forceinline=True)
-def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
-    """The straight-line slip: 2 (mag - fd) / k_eff along e = F / norm, k_eff = e^T K_ii e.
+def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd, sf):
+    """The straight-line slip: sf (mag - fd) / k_eff along e = F / norm, k_eff = e^T K_ii e.
+
+    ``sf`` = 1 + friction.overshoot: 2 for the undamped half-oscillation (eq. `displacement`).
 
     ``mag`` is the force magnitude the slip starts from (mu_s N exactly at a
     driving event, |F| in an avalanche) and ``norm`` what F is divided by:
@@ -231,7 +233,7 @@ def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd):
     ex = Fx / norm
     ey = Fy / norm
     keff = kxx * ex * ex + 2.0 * kxy * ex * ey + kyy * ey * ey
-    length = 2.0 * (mag - fd) / keff
+    length = sf * (mag - fd) / keff
     return length * ex, length * ey
 
 
@@ -282,7 +284,7 @@ def slip_straight(net, settings, i, Fx, Fy, norm, mag):
     the network tilt test."""
     fd = settings.mu_d if net.unit_load else settings.mu_d * net.normal_load[i]  # mu_d * 1.0 == mu_d
     kxx, kxy, kyy = _diagonal_block(net, i)
-    dux, duy = straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd)
+    dux, duy = straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd, settings.slip_factor)
     return True, dux, duy
 
 

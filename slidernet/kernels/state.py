@@ -279,3 +279,11 @@ class Settings(NamedTuple):
     # avalanche that sets every node in motion is the network sliding away (network kernels). False:
     # the kernels keep no count of the moving nodes at all.
     slide_away: bool = False
+    # A slip's length over (|F_i| - mu_d N_i) / K_ii: 1 + e, e = friction.overshoot (2.0: the paper's
+    # undamped half-oscillation, eq. `displacement`; 1.0: the slip stops where |F_i| = mu_d N_i).
+    slip_factor: float = 2.0
+    # The network tilt test's sliding rule (tilt_net): one avalanche above mu_d in which every node has
+    # slipped at least tilt_min_slips times and the centre of mass has moved along +x by at least
+    # tilt_min_shift (in Ntilde l0; 0: no such condition).
+    tilt_min_slips: int = 1
+    tilt_min_shift: float = 0.0

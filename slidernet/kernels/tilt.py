@@ -22,7 +22,7 @@ def flat_onset(F, mu1, mu2):
 
 
 @kernel_jit(inline="always")
-def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
+def tilt_iterations(st, draws, F, mu1, mu2, mu_d, sf, onset):
     """The appendix's iteration of the tilt test, for a rule of onset ``onset(F, mu1, mu2) -> (i, f, c)``.
 
     ``onset`` gives the slider i that starts first, the tangential load f at
@@ -30,6 +30,10 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
     The appendix's rules then act on the forces per unit normal load, the
     spring's being F / c; F is carried in units of the normal load on the
     flat. With :func:`flat_onset` (c = 1) this is the appendix as written.
+    A slider that rearranges alone moves the spring force by ``sf`` (mu_i -
+    mu_d), sf = 1 + e the slip factor (2: the appendix), and eq. `stab`'s
+    bound follows: the other slider is dragged along if, at the end of the
+    slip, the force on it reaches its threshold.
     Returns f at which the pair slides, ``TILT_NEED_DRAWS`` if the draw
     buffers ran out (read positions left untouched), ``TILT_TOO_LONG`` after
     ``TILT_MAX_ITER`` iterations.
@@ -41,7 +45,12 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
     for _ in range(TILT_MAX_ITER):
         i, f, c = onset(F, mu1, mu2)
         FN = F / c  # exact for c = 1
-        bound = mu_d - 0.5 * (mu1 - mu2) if i == 1 else mu_d + 0.5 * (mu1 - mu2)
+        # Eq. `stab` for a slip of sf (mu_i - mu_d): (mu1 + mu2 - sf (mu_i - mu_d)) / 2, written so that sf = 2
+        # adds an exact 0.0 to the appendix's own expression (the same bits).
+        if i == 1:
+            bound = mu_d - 0.5 * (mu1 - mu2) + (1.0 - 0.5 * sf) * (mu1 - mu_d)
+        else:
+            bound = mu_d + 0.5 * (mu1 - mu2) + (1.0 - 0.5 * sf) * (mu2 - mu_d)
         if f >= bound:  # eq. `stab`: the other slider moves too
             if f > mu_d:
                 st.tilt_mu_pos = p_mu
@@ -61,10 +70,10 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
             if p_mu + 1 > tilt_mu.size:
                 return TILT_NEED_DRAWS
             if i == 1:
-                FN += 2.0 * (mu1 - mu_d)
+                FN += sf * (mu1 - mu_d)
                 mu1 = tilt_mu[p_mu]
             else:
-                FN -= 2.0 * (mu2 - mu_d)
+                FN -= sf * (mu2 - mu_d)
                 mu2 = tilt_mu[p_mu]
             p_mu += 1
         F = FN * c  # exact for c = 1
@@ -72,17 +81,18 @@ def tilt_iterations(st, draws, F, mu1, mu2, mu_d, onset):
 
 
 @kernel_jit()
-def tilt_test_pair(st, draws, F, mu1, mu2, mu_d):
+def tilt_test_pair(st, draws, F, mu1, mu2, mu_d, sf):
     """The appendix's virtual tilt test on a copy of (F, mu1, mu2).
 
-    ``F`` is F_{1->2}, the spring force on slider 2 in units of N. The
+    ``F`` is F_{1->2}, the spring force on slider 2 in units of N; ``sf`` is
+    the slip factor 1 + e (2 for the appendix's slip). The
     redrawn thresholds and uniforms are read from ``draws.tilt_mu`` and
     ``draws.tilt_u`` at the state's ``tilt_mu_pos`` and ``tilt_u_pos``.
     Returns the tangential force f at which the whole system slides (mu_eff
     sample), ``TILT_NEED_DRAWS`` if the draw buffers ran out (read positions
     are then left untouched), or ``TILT_TOO_LONG`` after ``TILT_MAX_ITER`` iterations.
     """
-    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, flat_onset)
+    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, sf, flat_onset)
 
 
 @kernel_jit()
@@ -117,6 +127,6 @@ def record_tilt(f, out, k):
 
 
 @kernel_jit()
-def tilt_sample(st, draws, out, k, F, mu1, mu2, mu_d):
+def tilt_sample(st, draws, out, k, F, mu1, mu2, mu_d, sf):
     """Run one tilt test and add its sample to output bin ``k``; returns a status."""
-    return record_tilt(tilt_test_pair(st, draws, F, mu1, mu2, mu_d), out, k)
+    return record_tilt(tilt_test_pair(st, draws, F, mu1, mu2, mu_d, sf), out, k)

@@ -13,21 +13,31 @@ On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
    threshold from the tilt stream.
 3. **The whole network is set in motion** when, during one avalanche, every
    node has slipped or is unstable. This is checked after each slip has moved
-   force to its neighbours and before its threshold is redrawn: for two
-   sliders it is eq. `stab` (the other slider moves too).
+   force to its neighbours and before its threshold is redrawn (the slipped
+   node counts as stable until then): for two sliders it is eq. `stab` (the
+   other slider moves too).
 
    * If the total tangential load exceeds the total dynamic friction,
      f + f_bar > mu_d with f_bar = sum_i f_ext,i,x / sum_i N_i, the motion
      accelerates: the network slides, and the load per unit normal load at
      that moment, f + f_bar, is the sample of mu_eff (f itself, tan(alpha_c),
      when there is no f_ext).
+     A stricter sliding rule (``settings.tilt_min_slips = m`` > 1, the
+     ``[tilt]`` table's ``min_slips``; ``tilt_min_shift`` > 0, its
+     ``min_displacement``) asks more of that avalanche before it counts:
+     every node has slipped m times in it (or m - 1 times and is unstable,
+     about to slip again), and its centre of mass has moved along +x by
+     ``tilt_min_shift``. Until it has, the avalanche goes on and the sample
+     is the load at the first slip where the rule is met. The motion itself
+     does not depend on the rule, so a stricter rule never gives a lower
+     sample on the same state and draws.
    * Otherwise the collective motion is damped (creep). For a 1D pair the
      appendix's rule is used: both thresholds are redrawn and the spring force
      is drawn uniformly between the two values that keep both sliders stable
      under f. For N > 2 (or in 2D) that stable set is a polytope with no
      natural uniform measure, so the damped motion is resolved by the slip
      rule itself: the avalanche goes on and the count of moving nodes starts
-     again.
+     again (the sliding rule's counts too).
 
 4. **A part of the network slides on its own** when one avalanche at fixed f
    exceeds ``av_cap`` slips without having set every node in motion (counted
@@ -44,10 +54,12 @@ sequence of critical forces, the same draws in the same order, and so the
 same mu_eff (tested against :func:`slidernet.kernels.tilt.tilt_test_pair`).
 One case differs, outside the paper's parameters: the appendix never lets a
 slider slip backwards, while here a slider whose threshold drops below
-mu_s,old - 2 mu_d after its slip does (it is unstable).
+mu_s,old - 2 mu_d after its slip does (it is unstable). With another slip
+rule (``friction.overshoot`` e < 1) the pair's test is the appendix's with
+that slip, as :func:`slidernet.kernels.tilt.tilt_test_pair` makes it.
 
 Work arrays are the caller's: two :class:`~slidernet.kernels.state.Heaps`
-over the N nodes (``Heaps.empty(2, N)``) and ``epoch`` (N,) int64, so that a
+over the N nodes (``Heaps.empty(2, N)``), ``epoch`` and ``count`` (N,) int64, so that a
 test allocates nothing.
 """
 
@@ -69,8 +81,8 @@ STOP = 4  # why the test gave up (out): STOP_SLIPS, STOP_PART, STOP_SLIP_MOTION;
 # The test's counters, kept here when it returns for draws so that it can resume where it stood.
 S_NODE = 5  # the node whose threshold is to be redrawn
 S_EP = 6  # the current avalanche (see ``epoch``)
-S_MOVED = 7
-S_PENDING = 8
+S_MOVING = 7  # nodes in motion in the current avalanche: slipped at least once, or unstable (rule 3)
+S_DONE = 8  # nodes that meet the sliding rule's tilt.min_slips (``_in_motion`` with m)
 S_AV = 9  # slips of the current avalanche (rule 4)
 N_POS = 10
 
@@ -88,7 +100,8 @@ STOP_SLIP_MOTION = 3  # an exactly integrated slip did not come to rest within i
 L_FIRST = 0  # at the test's first slip (the first critical f)
 L_MOVING = 1  # when an avalanche first set every node in motion at once, whatever its relation to mu_d
 L_F = 2  # the tilt f reached so far: where a test resumes, and the load of a test that gave up
-N_LOADS = 3
+L_SHIFT = 3  # not a load: the current avalanche's displacement of the centre of mass along x, Ntilde l0
+N_LOADS = 4
 
 # The test's two heaps.
 _UNSTABLE = 0  # unstable nodes keyed by overload
@@ -150,9 +163,17 @@ def _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
     return p_mu + 2, p_u + 1
 
 
+@kernel_jit(forceinline=True)
+def _in_motion(c, m, unstable):
+    """Whether a node that has slipped c times in the current avalanche counts as in motion under the rule of
+    ``m`` slips: it has slipped m times, or m - 1 times and is unstable now (about to slip the m-th). With
+    m = 1: it has slipped, or it is unstable."""
+    return c >= m or (c == m - 1 and unstable)
+
+
 @kernel_jit(inline="always")
-def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch, loads,
-               slip):
+def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch, count,
+               loads, slip):
     """Raise a uniform tilt on a copy of a network until it slides as a whole.
 
     Parameters
@@ -170,7 +191,11 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         Block-CSR rows of K (1D padded to 2 x 2 blocks) and the loads N_i; the
         tilt force on node i is f N_i along +x.
     settings : Settings
-        mu_d and max_slips (give up after this many slips).
+        mu_d, max_slips (give up after this many slips), slip_factor (the
+        slip rule's 1 + e), and the sliding rule: one avalanche above mu_d in
+        which every node has slipped at least ``tilt_min_slips`` times (or
+        that many less one and is unstable) and the centre of mass has moved
+        by ``tilt_min_shift`` along +x (Ntilde l0; 0: no such condition).
     pair_rule : bool
         Use the appendix's creep rule (a 1D pair of sliders).
     tilt_mu, tilt_u : ndarray
@@ -187,6 +212,9 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         Two heaps over the N nodes (work array).
     epoch : ndarray of int64, shape (N,)
         Work array: the avalanche in which each node last slipped.
+    count : ndarray of int64, shape (N,)
+        Work array: how many times each node slipped in the avalanche
+        ``epoch[j]`` (the sliding rule of ``settings.tilt_min_slips``).
     slip : compiled function
         The slip rule, ``slip(net, settings, i, Fx, Fy, norm, mag) -> (ok, du_x, du_y)``.
     loads : ndarray of float64, shape (N_LOADS,)
@@ -211,6 +239,9 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
     """
     N = mu.size
     normal_load = net.normal_load
+    w = net.w
+    m = settings.tilt_min_slips
+    min_shift = settings.tilt_min_shift
     p_mu = pos[P_MU]
     p_u = pos[P_U]
     stage = pos[STAGE]
@@ -224,18 +255,21 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             epoch[j] = -1
         ep = 0
         slips = 0
-        # moved: nodes that slipped in the current avalanche; pending: unstable nodes that have not.
-        moved = 0
-        pending = heaps.size[_UNSTABLE]
+        # moving: nodes in motion in the current avalanche (slipped, or unstable: before any slip, the
+        # unstable ones); done: nodes that meet the sliding rule of m slips (the same as moving for m = 1).
+        moving = heaps.size[_UNSTABLE]
+        done = moving if m == 1 else 0
+        shift = 0.0
         av_slips = 0
         i = -1
     else:
         f = loads[L_F]
+        shift = loads[L_SHIFT]
         i = pos[S_NODE]
         ep = pos[S_EP]
         slips = pos[N_SLIPS]
-        moved = pos[S_MOVED]
-        pending = pos[S_PENDING]
+        moving = pos[S_MOVING]
+        done = pos[S_DONE]
         av_slips = pos[S_AV]
     pos[STOP] = 0
     while True:
@@ -243,15 +277,20 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         # redraw the slipped node's threshold, or apply the pair's creep rule (both thresholds).
         if stage == R_CREEP:
             if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
-                return _wait_for_draws(pos, loads, R_CREEP, p_mu, p_u, f, i, ep, slips, moved, pending, av_slips)
+                return _wait_for_draws(pos, loads, R_CREEP, p_mu, p_u, f, i, ep, slips, moving, done, av_slips,
+                                       shift)
             p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
         elif stage == R_REDRAW:
             if p_mu + 1 > tilt_mu.size:
-                return _wait_for_draws(pos, loads, R_REDRAW, p_mu, p_u, f, i, ep, slips, moved, pending,
-                                       av_slips)
+                return _wait_for_draws(pos, loads, R_REDRAW, p_mu, p_u, f, i, ep, slips, moving, done, av_slips,
+                                       shift)
             mu[i] = tilt_mu[p_mu]
             p_mu += 1
-            _key(i, f, G, mu, normal_load, heaps)
+            now = _key(i, f, G, mu, normal_load, heaps)
+            # The slipped node counted as stable until its new threshold: one slip short of m, it counts if
+            # it is unstable now (it has slipped, so it is in motion already).
+            if epoch[i] == ep and count[i] == m - 1 and now:
+                done += 1
         driving = heaps.size[_UNSTABLE] == 0
         if driving:
             # Raise f to the next critical value; a new avalanche starts.
@@ -262,8 +301,9 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             if ep == 0:
                 loads[L_FIRST] = f + f_bar
             ep += 1
-            moved = 0
-            pending = 0
+            moving = 0
+            done = 0
+            shift = 0.0
             av_slips = 0
         else:
             i = heaps.node[_UNSTABLE, 0]
@@ -277,14 +317,17 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             if f + f_bar > settings.mu_d:
                 return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
             return _give_up(pos, loads, f, STOP_PART)
-        if epoch[i] != ep:
-            if heaps.slot[i, _UNSTABLE] >= 0:
-                pending -= 1
-            epoch[i] = ep
-            moved += 1
+        # Node i's count goes up by one; until its threshold is redrawn it counts as stable.
+        c = count[i] if epoch[i] == ep else 0
+        was = heaps.slot[i, _UNSTABLE] >= 0
+        moving += int(_in_motion(c + 1, 1, False)) - int(_in_motion(c, 1, was))
+        done += int(_in_motion(c + 1, m, False)) - int(_in_motion(c, m, was))
+        epoch[i] = ep
+        count[i] = c + 1
         ok, dux, duy = _displacement(net, settings, i, f, driving, G, mu, slip)
         if not ok:
             return _give_up(pos, loads, f, STOP_SLIP_MOTION)
+        shift += w[i] * dux
         spread(net, G, i, dux, duy)
         for p in range(net.indptr[i], net.indptr[i + 1]):
             j = net.indices[p]
@@ -292,15 +335,22 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
                 continue
             was = heaps.slot[j, _UNSTABLE] >= 0
             now = _key(j, f, G, mu, normal_load, heaps)
-            if epoch[j] != ep:
-                pending += int(now) - int(was)
+            cj = count[j] if epoch[j] == ep else 0
+            if cj == 0:
+                moving += int(now) - int(was)
+            if cj == m - 1:
+                done += int(now) - int(was)
         stage = R_REDRAW
-        if moved + pending == N:
-            # Every node is in motion at once.
+        if moving == N:
+            # Every node is in motion at once (rule 3). Whether that motion is damped depends on the load
+            # alone; the sliding rule (m slips, a displacement) only says when a motion above mu_d counts.
             if math.isnan(loads[L_MOVING]):
                 loads[L_MOVING] = f + f_bar
             if f + f_bar > settings.mu_d:
-                return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
+                if done == N and (min_shift <= 0.0 or shift >= min_shift):
+                    return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
+                # Above mu_d, the rule not yet met: the avalanche goes on, its counts kept.
+                continue
             if pair_rule:
                 stage = R_CREEP
                 continue
@@ -308,11 +358,14 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             # from the node that is moving now.
             ep += 1
             epoch[i] = ep
-            moved = 1
+            count[i] = 1
+            shift = w[i] * dux
             # Rule 4 counts the slips since every node was last in motion: a long damped collective
             # motion in a large network is not a part sliding alone.
             av_slips = 0
-            pending = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
+            others = heaps.size[_UNSTABLE] - (1 if heaps.slot[i, _UNSTABLE] >= 0 else 0)
+            moving = 1 + others
+            done = int(_in_motion(1, m, False)) + (others if m == 1 else 0)
 
 
 @kernel_jit(forceinline=True)
@@ -335,7 +388,7 @@ def _give_up(pos, loads, f, why):
 
 
 @kernel_jit(forceinline=True)
-def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moved, pending, av_slips):
+def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moving, done, av_slips, shift):
     """Keep where the test stands, to resume at ``stage`` once the buffers are longer."""
     pos[P_MU] = p_mu
     pos[P_U] = p_u
@@ -343,25 +396,26 @@ def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moved, pendin
     pos[S_NODE] = i
     pos[S_EP] = ep
     pos[N_SLIPS] = slips
-    pos[S_MOVED] = moved
-    pos[S_PENDING] = pending
+    pos[S_MOVING] = moving
+    pos[S_DONE] = done
     pos[S_AV] = av_slips
     loads[L_F] = f
+    loads[L_SHIFT] = shift
     return TILT_NEED_DRAWS
 
 
 @kernel_jit()
 def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      loads):
+                      count, loads):
     """The network tilt test with straight-line slips (1D networks, and 2D with ``solver.slip = "straight"``):
     :func:`_tilt_test`, whose docstring gives the parameters."""
     return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      loads, slip_straight)
+                      count, loads, slip_straight)
 
 
 @kernel_jit()
 def tilt_test_network_exact(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps,
-                            epoch, loads):
+                            epoch, count, loads):
     """The network tilt test with the exactly integrated 2D slip (``solver.slip = "exact"``)."""
     return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      loads, slip_exact)
+                      count, loads, slip_exact)

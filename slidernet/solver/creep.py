@@ -47,13 +47,15 @@ class CreepSpec(NamedTuple):
     weights: np.ndarray  # (N,) w_i = N_i / sum_j N_j: x_G = sum_i w_i u_i
 
 
-def reference_slip(mu_s_mean: float, mu_d: float, normal_load: np.ndarray, k: np.ndarray, Ntilde: float) -> float:
-    """The slip of one slider held by one spring: ell = 2 (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>, in l0.
+def reference_slip(mu_s_mean: float, mu_d: float, normal_load: np.ndarray, k: np.ndarray, Ntilde: float,
+                   slip_factor: float = 2.0) -> float:
+    """The slip of one slider held by one spring: ell = (1 + e) (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>, in l0.
 
     A slider of threshold mu_s and normal load N held by one spring of
-    stiffness k slips by 2 (mu_s - mu_d) N / k (docs/model.md section 1); in
-    the model's units (forces in N, stiffnesses in k0 = N / (Ntilde l0)) that
-    is 2 (mu_s - mu_d) N_i Ntilde l0 / k. Means over the law of mu_s, the
+    stiffness k slips by (1 + e) (mu_s - mu_d) N / k (docs/model.md section 1;
+    e = ``friction.overshoot``, 1 for the paper's slip); in the model's units
+    (forces in N, stiffnesses in k0 = N / (Ntilde l0)) that is
+    (1 + e) (mu_s - mu_d) N_i Ntilde l0 / k. Means over the law of mu_s, the
     nodes and the springs.
 
     Parameters
@@ -68,13 +70,15 @@ def reference_slip(mu_s_mean: float, mu_d: float, normal_load: np.ndarray, k: np
         Spring stiffnesses, in k0.
     Ntilde : float
         N / (k l0).
+    slip_factor : float
+        1 + e (2.0: the paper's slip).
 
     Examples
     --------
     >>> round(reference_slip(0.6, 0.5, np.ones(2), np.ones(1), 1e-7) / 1e-8, 12)  # 2 (0.6 - 0.5) 1e-7 / 1e-8
     2.0
     """
-    return float(2.0 * (mu_s_mean - mu_d) * np.mean(normal_load) * Ntilde / np.mean(k))
+    return float(slip_factor * (mu_s_mean - mu_d) * np.mean(normal_load) * Ntilde / np.mean(k))
 
 
 def whole_cycles(steps: int, period: float) -> int:

@@ -100,7 +100,7 @@ class Realization:
         if scene.tilt_loads:
             self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
         self._tilted = 0  # recorded times whose network tilt test is done
-        self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
         self.state["theta"] = self.thetas[0]
         self.state["u"] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
@@ -232,9 +232,9 @@ class Realization:
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         if self._tilt_work is None:
-            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64),
+            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N, np.int64),
                                np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS))
-        heaps, epoch, pos, loads = self._tilt_work
+        heaps, epoch, count, pos, loads = self._tilt_work
         F = self.forces().reshape(N, -1)
         G = np.zeros((N, 2))
         G[:, : F.shape[1]] = F
@@ -247,7 +247,7 @@ class Realization:
         while True:
             buffers = self.buffers
             f = o.test(G, mu, o.f_ext, o.f_bar, o.net, settings, o.pair_rule, buffers.tilt_mu, buffers.tilt_u, pos,
-                       cap, heaps, epoch, loads)
+                       cap, heaps, epoch, count, loads)
             status = kernels.tilt_status(f)
             if status == kernels.DONE:
                 st["tilt_mu_pos"], st["tilt_u_pos"] = pos[tilt_net.P_MU], pos[tilt_net.P_U]
@@ -293,7 +293,7 @@ class Realization:
         if self.scene.tilt_loads:
             from slidernet.kernels.tilt_net import L_FIRST, L_MOVING
 
-            loads = self._tilt_work[3]
+            loads = self._tilt_work[4]
             self.out["tilt_first_slip"][k] = loads[L_FIRST]
             self.out["tilt_all_moving"][k] = loads[L_MOVING]
 

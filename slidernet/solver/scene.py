@@ -159,6 +159,9 @@ class Scene:
     creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
     slide_away: bool = False
     records_slide: bool = False
+    slip_factor: float = 2.0  # 1 + friction.overshoot: a slip's length over (|F_i| - mu_d N_i) / K_ii
+    tilt_min_slips: int = 1  # the network tilt test's sliding rule (the [tilt] table)
+    tilt_min_shift: float = 0.0  # ... and the centre of mass's displacement it needs, in Ntilde l0
     operators: Chain | Plane | None = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
     _K: Any = field(default=None, repr=False)
@@ -184,7 +187,9 @@ class Scene:
     def settings(self) -> Settings:
         """The run's constants, as the kernels take them."""
         return Settings(mu_d=float(self.mu_d), max_slips=int(self.max_avalanche),
-                        recompute_every=int(self.recompute_every), slide_away=bool(self.slide_away))
+                        recompute_every=int(self.recompute_every), slide_away=bool(self.slide_away),
+                        slip_factor=float(self.slip_factor), tilt_min_slips=int(self.tilt_min_slips),
+                        tilt_min_shift=float(self.tilt_min_shift))
 
     @classmethod
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
@@ -205,6 +210,14 @@ class Scene:
             except ValueError as exc:  # a network given here that the configuration's checks never saw
                 raise ConfigError(f"The 'mu_eff_at' field: {exc}.") from None
         slide_away = mean_load(net) > cfg.friction.mu_d
+        tilt = cfg.tilt_settings()
+        min_shift = 0.0
+        if tilt.min_displacement > 0.0:
+            # In mean slip lengths of one slider held by one spring (the creep observables' reference slip),
+            # given to the kernel in its lengths, Ntilde l0.
+            min_shift = tilt.min_displacement * reference_slip(
+                float(cfg.distribution().mean_max(1)), cfg.friction.mu_d, net.normal_load, net.k, 1.0,
+                cfg.friction.slip_factor())
         return cls(
             network=net,
             distribution=cfg.distribution(),
@@ -227,6 +240,9 @@ class Scene:
             creep=creep_spec(cfg, net) if "creep" in cfg.observables else None,
             slide_away=slide_away,
             records_slide=slide_away or cfg.network.incline is not None,
+            slip_factor=cfg.friction.slip_factor(),
+            tilt_min_slips=tilt.min_slips,
+            tilt_min_shift=min_shift,
             operators=operators,
         )
 
@@ -241,7 +257,8 @@ def creep_spec(cfg: Config, net: Network) -> CreepSpec:
             f"The 'creep' observable needs the mean of p(mu_s) for its reference slip, and the distribution "
             f"{cfg.friction.static.name!r} gives none: {exc}"
         ) from None
-    slip = reference_slip(mu_s_mean, cfg.friction.mu_d, net.normal_load, net.k, net.Ntilde)
+    slip = reference_slip(mu_s_mean, cfg.friction.mu_d, net.normal_load, net.k, net.Ntilde,
+                          cfg.friction.slip_factor())
     period = getattr(cfg.driver_plugin(), "period", None)
     return CreepSpec(period=None if period is None else float(period), transient=float(settings.transient),
                      slip=slip, threshold=settings.event_fraction * slip,

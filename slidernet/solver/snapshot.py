@@ -104,6 +104,9 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         "recompute_every": int(scene.recompute_every),
         "max_avalanche": int(scene.max_avalanche),
         "slip_mode": int(scene.slip_mode),
+        "slip_factor": float(scene.slip_factor),
+        "tilt_min_slips": int(scene.tilt_min_slips),
+        "tilt_min_shift": float(scene.tilt_min_shift),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": digest(*(getattr(ops, name) for name in _K_FIELDS if name in ops._fields)),
@@ -111,11 +114,15 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
     }
 
 
+# Entries added to the fingerprint after snapshots were written without them, and the value such a snapshot had.
+_FINGERPRINT_DEFAULTS = {"slip_factor": 2.0, "tilt_min_slips": 1, "tilt_min_shift": 0.0}
+
+
 def check_fingerprint(saved: Any, scene: Scene) -> None:
     """Refuse a snapshot written for another scene, naming the first entry that differs."""
     saved = saved if isinstance(saved, dict) else {}
     for key, value in scene_fingerprint(scene).items():
-        if saved.get(key) != value:
+        if saved.get(key, _FINGERPRINT_DEFAULTS.get(key)) != value:
             raise SnapshotError(f"was written for another scene: its {key!r} is {saved.get(key)!r} there and "
                                 f"{value!r} here")
 

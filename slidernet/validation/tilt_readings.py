@@ -60,6 +60,8 @@ READINGS = ("threshold", "after", "incline", "incline_after")
 _AFTER = {"threshold": False, "after": True, "incline": False, "incline_after": True}
 _INCLINE = {"threshold": False, "after": False, "incline": True, "incline_after": True}
 LN10 = math.log(10.0)
+# The readings are those of the paper's appendix: its slip, 2 (mu_i - mu_d) (friction.overshoot = 1).
+PAPER_SLIP = 2.0
 
 
 @kernel_jit(forceinline=True)
@@ -108,14 +110,14 @@ def tilt_test_incline(st, draws, F, mu1, mu2, mu_d):
         tan(alpha_c); -1.0 if the draw buffers ran out, -2.0 after
         ``TILT_MAX_ITER`` iterations.
     """
-    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, incline_onset)
+    return tilt_iterations(st, draws, F, mu1, mu2, mu_d, PAPER_SLIP, incline_onset)
 
 
 @kernel_jit()
 def _test(st, draws, F, mu1, mu2, mu_d, incline):
     if incline:
         return tilt_test_incline(st, draws, F, mu1, mu2, mu_d)
-    return tilt_test_pair(st, draws, F, mu1, mu2, mu_d)
+    return tilt_test_pair(st, draws, F, mu1, mu2, mu_d, PAPER_SLIP)
 
 
 @kernel_jit()
