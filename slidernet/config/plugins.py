@@ -38,10 +38,10 @@ class FrictionConfig(_Strict):
     """Dynamic coefficient mu_d, the distribution of static thresholds mu_s, and the slip rule.
 
     ``overshoot = e``, in [0, 1]: a slip moves a node by
-    (1 + e) (|F_i| - mu_d N_i) / K_ii along its force. e = 1 (the default,
+    ``(1 + e) (|F_i| - mu_d N_i) / K_ii`` along its force. e = 1 (the default,
     also when the key is left out) is the paper's eq. `displacement`, the
     undamped half-oscillation under Coulomb friction, which leaves the node
-    at a force 2 mu_d N_i - |F_i|; e = 0 stops the slip where the force
+    at a force ``2 mu_d N_i - |F_i|``; e = 0 stops the slip where the force
     reaches mu_d N_i. It applies to every kernel and to both tilt tests.
     """
 
@@ -52,11 +52,11 @@ class FrictionConfig(_Strict):
         description="The distribution p(mu_s) of the static thresholds: a registered name and its "
                     "parameters; conditioned on mu_s > mu_d.")
     overshoot: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = Field(
-        None, description="e in [0, 1]: a slip moves a node by (1 + e)(|F| - mu_d N)/K_ii (None: 1, the "
+        None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's magnitude (None: 1, the "
                           "paper's undamped slip; 0: the slip stops at mu_d N).")
 
     def slip_factor(self) -> float:
-        """1 + e, the slip's length over (|F_i| - mu_d N_i) / K_ii (2.0: the paper's)."""
+        """1 + e, the slip's length over ``(|F_i| - mu_d N_i) / K_ii`` (2.0: the paper's)."""
         return 1.0 + (1.0 if self.overshoot is None else float(self.overshoot))
 
 
