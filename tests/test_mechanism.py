@@ -9,8 +9,9 @@ import xarray as xr
 
 import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
-from slidernet.analysis.trend import log_trend
+from slidernet.analysis.trend import grouped_mean_sem, log_trend, mean_sem
 from slidernet.errors import ConfigError
+from slidernet.plugins.distributions import Uniform, mean_min_quadrature
 
 from .conftest import make_config
 
@@ -83,6 +84,38 @@ def test_log_trend_of_mu_max_of_two_sliders_rises():
     # realization's slope is >= 0, seed 4, 3 realizations.
     out = log_trend(slidernet.run(PAIR)["mu_max"])
     assert (out["slope"].values >= 0).all() and out["realizations"] == 3
+
+
+def test_log_trend_against_another_abscissa_fits_its_logarithm():
+    # value = 2 ln(x) exactly, with x = 5 t (one realization) and 7 t^2 (the other): slopes 2 in ln x,
+    # and 2 and 4 in ln t.
+    t = np.array([1.0, 10.0, 100.0])
+    x = np.array([5.0 * t, 7.0 * t**2])
+    v = xr.DataArray(2.0 * np.log(x), dims=("realization", "t"), coords={"t": t})
+    against = xr.DataArray(x, dims=("realization", "t"), coords={"t": t})
+    np.testing.assert_allclose(log_trend(v, against=against)["slope"].values, [2.0, 2.0], rtol=1e-12)
+    np.testing.assert_allclose(log_trend(v)["slope"].values, [2.0, 4.0], rtol=1e-12)
+    with pytest.raises(ConfigError, match="has the shape"):
+        log_trend(v, against=against.isel(t=[0, 1]))
+
+
+def test_grouped_errors_take_the_spread_between_geometries():
+    # Four geometries whose realizations agree within each: the plain error sees only the spread inside
+    # geometries, the two-level one the spread between them too.
+    values = np.array([1.0, 1.01, 2.0, 2.01, 3.0, 3.01, 4.0, 4.01])
+    groups = np.repeat([0, 1, 2, 3], 2)
+    mean, sem, dof = grouped_mean_sem(values, groups)
+    assert (mean, dof) == (pytest.approx(2.505), 3)
+    assert sem == pytest.approx(np.std([1.005, 2.005, 3.005, 4.005], ddof=1) / 2)
+    assert grouped_mean_sem(values, np.arange(8))[:2] == pytest.approx(mean_sem(values)[:2])
+    with pytest.raises(ConfigError, match="one shape"):
+        grouped_mean_sem(values, groups[:3])
+
+
+@pytest.mark.parametrize("m", [1, 2, 16, 1024])
+def test_the_mean_of_the_weakest_of_m_draws_is_exact(m):
+    # Uniform(a, b): E[min of m] = a + (b - a) / (m + 1).
+    assert float(mean_min_quadrature(Uniform(0.5, 0.7), m)) == pytest.approx(0.5 + 0.2 / (m + 1), rel=1e-12)
 
 
 def test_log_trend_refuses_what_it_cannot_fit():

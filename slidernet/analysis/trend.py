@@ -8,7 +8,9 @@ each realization's own line against ln t and takes the standard error from
 the spread of those per-realization slopes, and :func:`creep_law` tells
 steady from logarithmic creep by each realization's mean velocity over two
 successive log-spaced windows. :func:`mean_sem` is the rule under all of
-them: the mean of one value per realization and its standard error.
+them: the mean of one value per realization and its standard error;
+:func:`grouped_mean_sem` is the same where realizations share a quenched
+geometry, from the geometries' means.
 """
 
 from __future__ import annotations
@@ -69,7 +71,52 @@ def mean_sem(values: ArrayLike) -> tuple[float, float, int]:
     return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)) if a.size > 1 else math.nan, int(a.size)
 
 
-def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None) -> xr.Dataset:
+def grouped_mean_sem(values: ArrayLike, groups: ArrayLike) -> tuple[float, float, int]:
+    """Mean and standard error of per-realization values whose realizations share quenched groups (network
+    geometries): the two-level estimate.
+
+    Each group's mean over its realizations first, then the mean of the G
+    group means and its standard error, std(group means, ddof=1) / sqrt(G),
+    with G - 1 degrees of freedom. The spread between groups (another
+    network of the same size) is then in the error, as it is not when every
+    realization is taken as independent. Non-finite values are left out; a
+    group without a finite value does not count. With one group per
+    realization this is :func:`mean_sem`.
+
+    Parameters
+    ----------
+    values : array_like, shape (R,)
+        One value per realization, in any unit.
+    groups : array_like, shape (R,)
+        The group (e.g. the network seed) of each realization.
+
+    Returns
+    -------
+    mean, sem : float
+        In the unit of ``values``; NaN where there is no group (``sem``: fewer
+        than two).
+    dof : int
+        G - 1, the degrees of freedom of ``sem`` (for a Student-t quantile).
+
+    Examples
+    --------
+    Two geometries of two realizations each: their means are 1 and 3.
+
+    >>> grouped_mean_sem([0.5, 1.5, 3.0, 3.0], [0, 0, 7, 7])
+    (2.0, 1.0, 1)
+    """
+    v = np.asarray(values, dtype=np.float64)
+    g = np.asarray(groups)
+    if v.shape != g.shape or v.ndim != 1:
+        raise ConfigError(f"grouped_mean_sem needs values and groups of one shape (R,); got {v.shape} and "
+                          f"{g.shape}.")
+    means = [v[(g == key) & np.isfinite(v)].mean() for key in np.unique(g) if np.isfinite(v[g == key]).any()]
+    mean, sem, count = mean_sem(means)
+    return mean, sem, max(count - 1, 0)
+
+
+def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None,
+              against: xr.DataArray | None = None) -> xr.Dataset:
     """The slope d(values)/d(ln t) of every realization, and the ensemble's with its standard error.
 
     Each realization r gets its least-squares line values_r(t) = a_r + b_r ln t
@@ -86,6 +133,10 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
         ...), in its own units.
     t_min, t_max : float
         The times fitted, in tau_th; t_min > 0 (ln t). t_max: the last recorded time.
+    against : xarray.DataArray, dims (realization, t), optional
+        Another abscissa, per realization and recorded time, > 0 where
+        fitted (the slips per node, say): the slopes are then against its
+        logarithm, over the same times. Default: t.
 
     Returns
     -------
@@ -122,13 +173,20 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     keep = (t >= t_min) & (t <= (t[-1] if t_max is None else t_max))
     if keep.sum() < 2:
         raise ConfigError(f"log_trend: fewer than two recorded times in [{t_min}, {t_max}].")
-    x = np.log(t[keep])
     y = values.values[:, keep].astype(np.float64)
-    ok = np.isfinite(y)
+    if against is None:
+        x = np.broadcast_to(np.log(t[keep]), y.shape)
+    else:
+        a, _ = _per_realization(against, "log_trend's 'against'")
+        if a.shape != values.shape:
+            raise ConfigError(f"log_trend's 'against' has the shape {a.shape}, the values {values.shape}.")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.log(a.values[:, keep].astype(np.float64))
+    ok = np.isfinite(y) & np.isfinite(x)
     slope = np.full(y.shape[0], np.nan)
     for r in range(y.shape[0]):
         if ok[r].sum() >= 2:
-            xr_, yr = x[ok[r]], y[r, ok[r]]
+            xr_, yr = x[r, ok[r]], y[r, ok[r]]
             dx = xr_ - xr_.mean()
             slope[r] = float(dx @ (yr - yr.mean()) / (dx @ dx))
     fitted = np.isfinite(slope)

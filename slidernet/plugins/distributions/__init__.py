@@ -58,7 +58,7 @@ and every name below is imported from the package itself, as before:
 ==================  ===========================================================
 module              holds
 ==================  ===========================================================
-``quadrature``      :func:`mean_max_quadrature` (a tanh-sinh rule on the quantile)
+``quadrature``      :func:`mean_max_quadrature` and :func:`mean_min_quadrature` (a tanh-sinh rule on the quantile)
 ``law``             :class:`Distribution`, :class:`TruncatedBelow`, :data:`MIN_MASS`
 ``stream``          :class:`TruncatedStream`, :data:`RAW_CHUNK`
 ``bounded``         ``uniform``, ``constant``
@@ -73,7 +73,7 @@ from __future__ import annotations
 from slidernet.plugins.distributions.bounded import Constant, Uniform
 from slidernet.plugins.distributions.empirical import Empirical
 from slidernet.plugins.distributions.law import MIN_MASS, Distribution, TruncatedBelow
-from slidernet.plugins.distributions.quadrature import mean_max_quadrature
+from slidernet.plugins.distributions.quadrature import mean_max_quadrature, mean_min_quadrature
 from slidernet.plugins.distributions.scipy_laws import ScipyStats
 from slidernet.plugins.distributions.stream import RAW_CHUNK, TruncatedStream
 from slidernet.plugins.distributions.unbounded import Exponential, Gaussian, Lognormal, Pareto, Weibull
@@ -95,6 +95,7 @@ __all__ = [
     "Uniform",
     "Weibull",
     "mean_max_quadrature",
+    "mean_min_quadrature",
 ]
 
 # The built-in distributions, by the name a config uses (``friction.static.name``).
