@@ -1,59 +1,57 @@
-"""Does thermal cycling age the static friction of a network of sliders?
-=====================================================================
+"""Does thermal cycling age the static friction of a network of sliders? With the controls a referee asks for
+=========================================================================================================
 
 The paper (Geminard & Bertin 2010) ends on an open question: in a 2D
 irregular network of sliders, does the effective friction coefficient still
-increase with time under thermal cycling? This study measures it, from the
-base configuration ``examples/aging_networks.toml`` (mu_d = 0.5, gaussian
-mu_s of mean 0.6, Ntilde = 1e-7, driver ``gaussian_steps``, record "log").
+increase with time under thermal cycling? This study measures mu_eff, the
+network tilt test at every recorded time (``mu_eff_at = "records"``, the
+same estimator at every size, the pair included), and asks it where the
+pair ages, with the controls that decide whether an answer is an artefact:
 
-Estimator: ``mu_eff_at = "records"``, the network tilt test at every
-recorded time, for every network, the pair included: the same estimator at
-every size. mu_max (the strongest threshold) is reported beside it; it is
-not mu_eff. Every trend is :func:`slidernet.analysis.trend.log_trend` of a
-per-realization variable (``mu_eff_realization``, ``mu_max``, ``x_G**2``):
-slopes against ln t fitted per realization, errors from their spread over
-independent realizations. The mechanism (selection of strong thresholds,
-prestress) comes from :func:`slidernet.analysis.mechanism.node_states` at
-t = 0 and at the end, for a few sizes.
+* **Three parameter sets** (``PARAMS``): the base, sigma_mu / (mean - mu_d)
+  = 0.1 at mu_d = 0.5, and two where the pair ages: ratio 0.3 at mu_d = 0.5,
+  and ratio 0.1 at mu_d = 0.4 (mean 0.6, std 0.03 and 0.02), all at
+  sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade.
+* **Sizes and geometries**: the pair, free chains of 4 and 16 (driven at
+  their ends), irregular (Delaunay) networks of 16, 64, 256 and 1024 sliders
+  (driven everywhere: every node of an irregular network feels the
+  dilation), each over 8 network geometries (network seeds 0-7) of 4
+  realizations, and triangular lattices of 4 x 4 to 32 x 32 (driven at the
+  boundary, as the chains). 32 realizations per point.
+* **The slip rule**: ``friction.overshoot`` e = 0 and 0.5 beside the
+  paper's 1, for the pair and irregular 16, 64, 256, at ratios 0.1 and 0.3.
+* **The sliding rule**: the tilt test's stricter criteria, ``[tilt]
+  min_slips = 2`` and ``min_displacement = 10`` (the centre of mass moved
+  by 10 reference slips within the sliding avalanche), at e = 1 and e = 0,
+  for the same sizes and ratios.
 
-The grid of the full preset (16 realizations per point, seed 1, network
-seed 0):
+Every trend is :func:`slidernet.analysis.trend.log_trend` of a per-realization
+variable (slopes against ln t over 1 <= t <= t_end, or against the
+logarithm of the slips per node); its error is from independent
+realizations and, for the irregular networks, includes the spread between
+geometries (:func:`slidernet.analysis.trend.grouped_mean_sem`: each
+geometry's mean, then the spread of the 8 means, 7 degrees of freedom). Each
+slope gets a two-sided Student-t p-value, and the family of tests a
+Benjamini-Hochberg adjustment (``scipy.stats.false_discovery_control``).
 
-* chains (kind ``chain``; n = 2 runs on the pair kernel) of 2, 3, 4, 8, 16
-  sliders x friction.static.std 0.01, 0.02, 0.03 (sigma_mu / (mean - mu_d)
-  = 0.1, 0.2, 0.3) at sigma_theta / Ntilde = 1, 1e4 tau_th;
-* the same chains at sigma_theta / Ntilde = 10, std 0.01, 1e4 tau_th;
-* irregular 2D networks (kind ``irregular``) of 16 and 64 sliders x std
-  0.01, 0.02, 0.03, 1e4 tau_th, and of 256 sliders, std 0.01, 3e3 tau_th,
-  all at sigma_theta / Ntilde = 1;
-* irregular 16 and 64 at sigma_theta / Ntilde = 10, std 0.01, 1e3 tau_th;
-* irregular 1024, std 0.01, sigma_theta / Ntilde = 1, to 300 tau_th, 10
-  recorded times per decade;
-* a replica of the chains of 8 and 16 at std 0.01, sigma_theta / Ntilde = 1,
-  1e4 tau_th, with seed 2 and 64 realizations (independent of the first);
-* mechanism (node_states at t = 0 and at the end): chains of 2, 4, 16,
-  irregular networks of 16 and 64.
+Scaled observables: sqrt(N) (mu_eff - mu_d), in which a network with an
+excess over mu_d that falls as 1/sqrt(N) is flat by construction, and
+(mu_eff - mu_s_mean) / sigma_mu, in units of the law's spread; against t and
+against the slips per node. mu_eff(0), the fresh state, is set beside the
+exact mean of the weakest of N thresholds
+(:func:`slidernet.plugins.distributions.mean_min_quadrature`).
 
-Every point also records ``tilt_loads``: the load of the tilt test's first
-slip, and the load at which one of its avalanches first set every slider in
-motion, above mu_d or not, so that the answer does not rest on the tilt
-test's sliding rule alone.
-
-Cuts of the grid: 4096 sliders only in the ``large`` preset (8 realizations,
-to 300 tau_th, 5 recorded times per decade: the tilt test's cost grows
-fastest with size); std 0.02 and 0.03 not at 256 or 1024 sliders; sigma_theta / Ntilde =
-10 only at std 0.01, only to 1e3 tau_th for the irregular networks and not
-at 256 or above; 256 sliders only to 3e3 tau_th, 1024 to 300 tau_th.
-
-Writes ``aging_networks.json`` (every number, with its parameters and the
+Writes ``aging_networks.json`` (every number with its parameters and
 configurations) and ``aging_networks.png`` into ``--out``::
 
-    python examples/aging_networks.py --out aging_out --workers 2                 # the full preset
-    python examples/aging_networks.py --out aging_out --quick                     # seconds
-    python examples/aging_networks.py --out aging_large --preset large --workers 2  # 4096 sliders
+    python examples/aging_networks.py --out aging_out --workers 2                  # the full preset
+    python examples/aging_networks.py --out aging_out --quick                      # seconds; CI runs it
+    python examples/aging_networks.py --out aging_large --preset large --workers 2   # 4096 sliders
+    python examples/aging_networks.py --out aging_large --preset large --scheduler tcp://host:8786
 
-Units: time in tau_th, friction coefficients dimensionless, x_G in l0.
+``--resume`` continues an interrupted run: every sweep is resumable and the
+points already written are read back. Units: time in tau_th, friction
+coefficients dimensionless.
 """
 
 from __future__ import annotations
@@ -63,6 +61,7 @@ import dataclasses
 import json
 import math
 import time
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -71,12 +70,14 @@ import numpy as np
 import xarray as xr
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from scipy import stats
 
 import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
-from slidernet.analysis.trend import log_trend, mean_sem
+from slidernet.analysis.trend import grouped_mean_sem, log_trend, mean_sem
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import save_figure, write_json
+from slidernet.plugins.distributions import mean_min_quadrature
 
 try:
     BASE_TOML = Path(__file__).resolve().with_name("aging_networks.toml")
@@ -85,311 +86,383 @@ except NameError:  # sphinx-gallery defines no __file__; it runs the script from
 JSON_NAME = "aging_networks.json"
 PNG_NAME = "aging_networks.png"
 LN10 = math.log(10.0)
+MU_S_MEAN = 0.6  # the law's mean before its truncation at mu_d, in every parameter set
+
+
+@dataclasses.dataclass(frozen=True)
+class Params:
+    """A parameter set of the friction law: mu_d and the Gaussian's std (mean 0.6)."""
+
+    mu_d: float
+    std: float
+
+    @property
+    def ratio(self) -> float:
+        """sigma_mu / (mean - mu_d)."""
+        return round(self.std / (MU_S_MEAN - self.mu_d), 12)
+
+
+PARAMS = {"base": Params(0.5, 0.01), "ratio0.3": Params(0.5, 0.03), "mu_d0.4": Params(0.4, 0.02)}
 
 
 @dataclasses.dataclass(frozen=True)
 class Group:
-    """One sweep of the study: a network kind, a grid and a duration.
+    """Sweeps of one kind of network over its sizes, for some parameter sets and one slip and sliding rule.
 
     Attributes
     ----------
     name : str
         Label of the group in the JSON output.
     kind : str
-        Network kind: ``chain`` or ``irregular``.
+        ``pair`` (a chain of 2, on the pair kernel), ``chain``, ``irregular``
+        or ``triangular``.
     sizes : tuple of int
-        Numbers of sliders (``network.n``).
-    stds : tuple of float
-        Values of ``friction.static.std``.
-    sigma_ratio : float
-        sigma_theta / Ntilde.
-    steps : int
-        Duration in tau_th.
-    realizations : int, optional
-        Realizations per point, when not the preset's.
-    per_decade : int
-        Recorded times per decade of t (``log_points_per_decade``): fewer
-        tilt tests for the largest networks, where each costs most.
-    seed : int, optional
-        The ensemble's seed, when not the base configuration's (a replica
-        with independent realizations).
+        Numbers of sliders; for ``triangular``, the side L of an L x L lattice.
+    params : tuple of str
+        Keys of :data:`PARAMS`.
+    geometries : int
+        Network seeds 0, 1, ... (``irregular``): each its own sweep, with its
+        own ensemble seed, so that the geometries' realizations are independent.
+    overshoot : float
+        ``friction.overshoot`` e.
+    tilt : tuple of (str, value) pairs
+        The ``[tilt]`` table (empty: the rule of one slip per node).
+    mu_eff_at : str
+        ``records`` (the study's estimator), or ``rearrangements`` for the
+        pair: the paper's own estimator, the appendix's test before every
+        rearrangement, as a check of the study's on the pair.
     """
 
     name: str
     kind: str
     sizes: tuple[int, ...]
-    stds: tuple[float, ...]
-    sigma_ratio: float
-    steps: int
-    realizations: int | None = None
-    per_decade: int = 20
-    seed: int | None = None
+    params: tuple[str, ...] = tuple(PARAMS)
+    geometries: int = 1
+    overshoot: float = 1.0
+    tilt: tuple[tuple[str, float], ...] = ()
+    mu_eff_at: str = "records"
+
+    def rule(self) -> str:
+        """The slip and sliding rule in words (the JSON's and the figure's label)."""
+        parts = [f"e = {self.overshoot:g}"]
+        parts += [f"{key} = {value:g}" for key, value in self.tilt]
+        if self.mu_eff_at != "records":
+            parts.append("the appendix's test before every rearrangement")
+        return ", ".join(parts)
 
 
 @dataclasses.dataclass(frozen=True)
 class Preset:
-    """The whole study: its sweeps, ensemble size and the mechanism runs."""
+    """The whole study: its sweeps, its duration, and the mechanism runs."""
 
-    realizations: int
+    realizations: int  # per point: divided among the geometries of an irregular size
+    steps: int
+    per_decade: int
     groups: tuple[Group, ...]
-    mechanism: tuple[tuple[str, int, int], ...]   # (kind, n, steps)
+    mechanism: tuple[tuple[str, int], ...]  # (kind, N) at the base parameters
+
+
+def _scan(sizes: tuple[int, ...], params: tuple[str, ...], geometries: int) -> tuple[Group, ...]:
+    """The slip-rule and sliding-rule scan: the pair and irregular networks of ``sizes``, every rule."""
+    out = []
+    rules = [(0.0, ()), (0.5, ()), (1.0, (("min_slips", 2),)), (1.0, (("min_displacement", 10.0),)),
+             (0.0, (("min_slips", 2),)), (0.0, (("min_displacement", 10.0),))]
+    for e, tilt in rules:
+        tag = f"e{e:g}" + "".join(f"_{k}{v:g}" for k, v in tilt)
+        out.append(Group(f"pair_{tag}", "pair", (2,), params, overshoot=e, tilt=tilt))
+        out.append(Group(f"irregular_{tag}", "irregular", sizes, params, geometries, overshoot=e, tilt=tilt))
+    return tuple(out)
 
 
 PRESETS = {
     "full": Preset(
-        realizations=16,
+        realizations=32, steps=1000, per_decade=10,
         groups=(
-            Group("chains", "chain", (2, 3, 4, 8, 16), (0.01, 0.02, 0.03), 1.0, 10_000),
-            Group("chains_sigma10", "chain", (2, 3, 4, 8, 16), (0.01,), 10.0, 10_000),
-            Group("irregular", "irregular", (16, 64), (0.01, 0.02, 0.03), 1.0, 10_000),
-            Group("irregular_256", "irregular", (256,), (0.01,), 1.0, 3_000),
-            Group("irregular_sigma10", "irregular", (16, 64), (0.01,), 10.0, 1_000),
-            Group("irregular_1024", "irregular", (1024,), (0.01,), 1.0, 300, per_decade=10),
-            # An independent replica (seed 2, 64 realizations) of the two chain
-            # points that the first run found positive by about 3 standard errors.
-            Group("chains_replica", "chain", (8, 16), (0.01,), 1.0, 10_000, realizations=64, seed=2),
+            Group("pair", "pair", (2,)),
+            Group("pair_appendix", "pair", (2,), mu_eff_at="rearrangements"),
+            Group("chains", "chain", (4, 16)),
+            Group("irregular", "irregular", (16, 64, 256, 1024), geometries=8),
+            Group("lattices", "triangular", (4, 8, 16, 32)),
+            *_scan((16, 64, 256), ("base", "ratio0.3"), 8),
         ),
-        mechanism=(("chain", 2, 10_000), ("chain", 4, 10_000), ("chain", 16, 10_000),
-                   ("irregular", 16, 10_000), ("irregular", 64, 10_000)),
+        mechanism=(("pair", 2), ("chain", 16), ("irregular", 64)),
     ),
-    # Beyond the full preset's budget: 4096 sliders, 8 realizations, to 300 tau_th.
+    # Beyond the full preset's budget: 4096 sliders, 8 geometries x 4 realizations, the three parameter sets.
     "large": Preset(
-        realizations=8,
-        groups=(Group("irregular_4096", "irregular", (4096,), (0.01,), 1.0, 300, per_decade=5),),
+        realizations=32, steps=1000, per_decade=5,
+        groups=(Group("irregular_4096", "irregular", (4096,), geometries=8),),
         mechanism=(),
     ),
     "quick": Preset(
-        realizations=4,
+        realizations=4, steps=100, per_decade=5,
         groups=(
-            Group("chains", "chain", (2, 4), (0.01, 0.02), 1.0, 300),
-            Group("irregular", "irregular", (16,), (0.01,), 1.0, 100),
+            Group("pair", "pair", (2,), ("base", "ratio0.3")),
+            Group("pair_appendix", "pair", (2,), ("base",), mu_eff_at="rearrangements"),
+            Group("chains", "chain", (4,), ("base", "ratio0.3")),
+            Group("irregular", "irregular", (16,), ("base", "ratio0.3"), geometries=2),
+            Group("lattices", "triangular", (4,), ("base",)),
+            Group("irregular_e0", "irregular", (16,), ("base",), 2, overshoot=0.0),
+            Group("irregular_e0_min_slips2", "irregular", (16,), ("base",), 2, overshoot=0.0,
+                  tilt=(("min_slips", 2),)),
         ),
-        mechanism=(("chain", 4, 300),),
+        mechanism=(("chain", 4),),
     ),
 }
 
 
-def base_config(realizations: int) -> dict[str, Any]:
-    """The study's base configuration (``aging_networks.toml``) as a plain dict."""
+def _n_nodes(kind: str, size: int) -> int:
+    return size * size if kind == "triangular" else size
+
+
+def point_config(group: Group, params: str, size: int, geometry: int, preset: Preset) -> dict[str, Any]:
+    """The configuration of one point (one size, one parameter set, one geometry) as a plain dict."""
     cfg = slidernet.load_config(BASE_TOML).model_dump(mode="json")
-    cfg["realizations"] = realizations
-    return cfg
-
-
-def group_config(group: Group, realizations: int) -> dict[str, Any]:
-    """The base configuration of one sweep (kind, duration, sigma_theta)."""
-    cfg = base_config(realizations if group.realizations is None else group.realizations)
+    p = PARAMS[params]
     ntilde = cfg["network"]["Ntilde"]
-    cfg["steps"] = group.steps
-    cfg["log_points_per_decade"] = group.per_decade
-    if group.seed is not None:
-        cfg["seed"] = group.seed
-    cfg["network"] = {"kind": group.kind, "n": group.sizes[0], "Ntilde": ntilde}
+    # Independent ensembles: a seed per parameter set and per geometry (the sizes of one sweep share it).
+    cfg["seed"] = 1 + 1000 * list(PARAMS).index(params) + geometry
+    cfg["realizations"] = preset.realizations // group.geometries
+    cfg["steps"] = preset.steps
+    cfg["log_points_per_decade"] = preset.per_decade
+    network: dict[str, Any] = {"kind": "chain" if group.kind == "pair" else group.kind, "Ntilde": ntilde}
+    if group.kind == "triangular":
+        network["shape"] = [size, size]
+    else:
+        network["n"] = size
     if group.kind == "irregular":
-        cfg["network"]["seed"] = 0
-    cfg["driver"] = {**cfg["driver"], "sigma_theta": group.sigma_ratio * ntilde}
+        network["seed"] = geometry
+    cfg["network"] = network
+    cfg["friction"] = {"mu_d": p.mu_d, "static": {"name": "gaussian", "mean": MU_S_MEAN, "std": p.std}}
+    if group.overshoot != 1.0:
+        cfg["friction"]["overshoot"] = group.overshoot
+    if group.tilt:
+        cfg["tilt"] = dict(group.tilt)
+    if group.mu_eff_at != "records":
+        cfg["mu_eff_at"] = group.mu_eff_at
+        cfg["observables"] = [o for o in cfg["observables"] if o != "tilt_loads"]  # a network tilt test's
+    cfg["driver"] = {**cfg["driver"], "sigma_theta": ntilde}  # sigma_theta / Ntilde = 1
     return cfg
 
 
-def _trend(values: xr.DataArray) -> dict[str, Any]:
-    """log_trend of one per-realization variable, with its value at t = 0, as plain numbers."""
-    tr = log_trend(values, t_min=1)
-    t0_mean, t0_sem, t0_count = mean_sem(values.sel(t=0).values)
-    return {
-        "t0_mean": t0_mean, "t0_sem": t0_sem, "t0_realizations": t0_count,
-        "start_mean": float(tr["start_mean"]), "start_sem": float(tr["start_sem"]),
-        "t_start": tr.attrs["t_start"],
-        "end_mean": float(tr["end_mean"]), "end_sem": float(tr["end_sem"]), "t_end": tr.attrs["t_end"],
-        "slope_per_ln_t_mean": float(tr["slope_mean"]), "slope_per_ln_t_sem": float(tr["slope_sem"]),
-        "slope_per_decade_mean": LN10 * float(tr["slope_mean"]),
-        "slope_per_decade_sem": LN10 * float(tr["slope_sem"]),
-        "realizations": int(tr["realizations"]),
-    }
+def run_sweeps(group: Group, params: str, preset: Preset, workers: int | None, scheduler: str | None,
+               out: Path | None, resume: bool) -> list[tuple[xr.Dataset, np.ndarray, list[dict[str, Any]]]]:
+    """Every size of ``group`` at ``params``: its realizations over all geometries, the independent unit each
+    belongs to (its geometry, or itself where there is one geometry), and the configurations."""
+    key = "network.shape" if group.kind == "triangular" else "network.n"
+    values: list[Any] = [[s, s] for s in group.sizes] if group.kind == "triangular" else list(group.sizes)
+    per_size: list[list[xr.Dataset]] = [[] for _ in group.sizes]
+    configs: list[list[dict[str, Any]]] = [[] for _ in group.sizes]
+    for g in range(group.geometries):
+        cfg = point_config(group, params, group.sizes[0], g, preset)
+        where = None if out is None else out / "sweeps" / group.name / params / f"geometry_{g}"
+        result = sweep(cfg, {key: values}, workers=workers, scheduler=scheduler, out=where,
+                       resume=resume and where is not None and (where / "sweep.json").exists(),
+                       overwrite=not resume, progress=None)
+        ds = result.to_dataset() if isinstance(result, xr.DataTree) else result
+        dim = ds["mu_max"].dims[0]
+        point_configs = json.loads(ds.attrs["configs"])
+        for i in range(len(group.sizes)):
+            per_size[i].append(ds.isel({dim: i}).drop_vars(dim, errors="ignore"))
+            configs[i].append(point_configs[i])
+    merged = []
+    for i in range(len(group.sizes)):
+        parts = per_size[i]
+        R = parts[0].sizes["realization"]
+        ds = xr.concat([p.assign_coords(realization=np.arange(R) + g * R) for g, p in enumerate(parts)],
+                       dim="realization", data_vars="minimal", coords="minimal", compat="override")
+        # One geometry: the realizations are the independent units; several: the geometries are.
+        groups = np.repeat(np.arange(len(parts)), R) if len(parts) > 1 else np.arange(R)
+        merged.append((ds, groups, configs[i]))
+    return merged
 
 
-def _curve(values: xr.DataArray) -> dict[str, list[float]]:
-    """Mean and standard error over realizations at every recorded time."""
-    v = values.transpose("realization", "t").values
-    count = np.isfinite(v).sum(axis=0)
-    mean = np.nanmean(np.where(count > 0, v, 0.0), axis=0)
-    std = np.nanstd(v, axis=0, ddof=1) if v.shape[0] > 1 else np.full(v.shape[1], np.nan)
-    sem = std / np.sqrt(np.maximum(count, 1))
-    return {"t": values["t"].values.tolist(), "mean": mean.tolist(), "sem": sem.tolist(), "count": count.tolist()}
+def _estimate(values: np.ndarray, geometry: np.ndarray) -> dict[str, Any]:
+    """Mean, standard error (geometries' spread included), degrees of freedom and two-sided p of zero."""
+    mean, sem, dof = grouped_mean_sem(values, geometry)
+    p = float(2.0 * stats.t.sf(abs(mean / sem), dof)) if sem > 0 and dof > 0 else math.nan
+    return {"mean": mean, "sem": sem, "dof": dof, "p": p}
 
 
-def _below(values: xr.DataArray, mu_d: float) -> dict[str, Any]:
-    """Per realization, the fraction of its tilt tests at t >= 1 whose collective motion began below mu_d.
-
-    One fraction per realization, so that the mean's error comes from
-    independent realizations.
-    """
-    v = values.sel(t=values["t"] >= 1).transpose("realization", "t").values
-    tested = np.isfinite(v)
-    frac = np.where(tested.any(axis=1), (tested & (v < mu_d)).sum(axis=1) / np.maximum(tested.sum(axis=1), 1),
-                    np.nan)
-    mean, sem, count = mean_sem(frac)
-    return {"mean": mean, "sem": sem, "realizations": count}
-
-
-def run_group(group: Group, realizations: int, workers: int | None, out: Path | None, resume: bool,
-              log: bool = True, scheduler: str | None = None) -> list[dict[str, Any]]:
-    """Run one sweep and reduce every point to its numbers."""
-    cfg = group_config(group, realizations)
-    grid: dict[str, list[Any]] = {"network.n": list(group.sizes), "friction.static.std": list(group.stds)}
-    start = time.perf_counter()
-    where = None if out is None else out / "sweeps" / group.name
-    result = sweep(cfg, grid, workers=workers, scheduler=scheduler, out=where, resume=resume and where is not None
-                   and (where / "sweep.json").exists(), overwrite=not resume, progress=None)
-    ds = result.to_dataset() if isinstance(result, xr.DataTree) else result
-    configs = json.loads(ds.attrs["configs"])
-    elapsed = time.perf_counter() - start
-    dims = ds["mu_max"].dims[:2]   # the sweep's dimensions, in the grid's order
-    points = []
-    for i, n in enumerate(group.sizes):
-        for j, std in enumerate(group.stds):
-            one = ds.isel({dims[0]: i, dims[1]: j})
-            x2 = one["x_G"] ** 2
-            point = {
-                "group": group.name, "kind": group.kind, "n": n, "std": std,
-                "std_over_gap": std / (0.6 - 0.5), "sigma_theta_over_Ntilde": group.sigma_ratio,
-                "steps": group.steps, "realizations": cfg["realizations"], "seed": cfg["seed"],
-                "r_mean": float(one["r_mean"]), "r_sem": float(one["r_sem"]),
-                "mu_eff": _trend(one["mu_eff_realization"]),
-                "mu_max": _trend(one["mu_max"]),
-                "x_G2": _trend(x2),
-                # What mu_eff rests on: the tilt test's first slip, and the load
-                # at which one of its avalanches first set every slider moving.
-                "tilt_first_slip": _trend(one["tilt_first_slip"]),
-                "tilt_all_moving": _trend(one["tilt_all_moving"]),
-                "all_moving_below_mu_d": _below(one["tilt_all_moving"], cfg["friction"]["mu_d"]),
-                "curves": {"mu_eff": _curve(one["mu_eff_realization"]), "mu_max": _curve(one["mu_max"]),
-                           "x_G2": _curve(x2), "tilt_all_moving": _curve(one["tilt_all_moving"])},
-                "config": configs[i * len(group.stds) + j],
-                "kernel": json.loads(ds.attrs["kernels"])[i * len(group.stds) + j]
-                if "kernels" in ds.attrs else ds.attrs["kernel"],
-            }
-            points.append(point)
-            if log:
-                e = point["mu_eff"]
-                print(f"{group.name} n={n} std={std}: mu_eff {e['t0_mean']:.4f} -> {e['end_mean']:.4f} "
-                      f"(slope/decade {e['slope_per_decade_mean']:+.5f} +- {e['slope_per_decade_sem']:.5f}), "
-                      f"all moving at {point['tilt_all_moving']['end_mean']:.4f}, "
-                      f"r = {point['r_mean']:.1f}/tau_th", flush=True)
-    if log:
-        print(f"{group.name}: {elapsed:.1f} s", flush=True)
-    return points
-
-
-def mechanism(kind: str, n: int, steps: int, realizations: int, log: bool = True) -> dict[str, Any]:
-    """Thresholds and load ratios of every node at t = 0 and t = steps (std 0.01, sigma_theta / Ntilde = 1)."""
-    group = Group("mechanism", kind, (n,), (0.01,), 1.0, steps)
-    cfg = group_config(group, realizations)
-    law_mean = float(slidernet.load_config(cfg).distribution().mean_max(1))
-    states = node_states(cfg, [0, steps])
-    summary = node_summary(states, law_mean=law_mean)
-    out: dict[str, Any] = {"kind": kind, "n": n, "steps": steps, "realizations": realizations,
-                           "law_mean": law_mean, "config": cfg}
-    for name in ("mu_s_shift", "load_ratio", "mu_s"):
-        for label, k in (("t0", 0), ("end", 1)):
-            out[f"{name}_{label}_mean"] = float(summary[f"{name}_mean"].isel(t=k))
-            out[f"{name}_{label}_sem"] = float(summary[f"{name}_sem"].isel(t=k))
-    # The change per realization, so that its error comes from independent realizations.
-    shift = (states["mu_s"].isel(t=1) - states["mu_s"].isel(t=0)).mean("node").values
-    ratio = (states["load_ratio"].isel(t=1) - states["load_ratio"].isel(t=0)).mean("node").values
-    out["mu_s_change_mean"], out["mu_s_change_sem"], _ = mean_sem(shift)
-    out["load_ratio_change_mean"], out["load_ratio_change_sem"], _ = mean_sem(ratio)
-    if log:
-        print(f"mechanism {kind} {n}: shift {out['mu_s_shift_t0_mean']:+.5f} -> "
-              f"{out['mu_s_shift_end_mean']:+.5f}, "
-              f"load ratio {out['load_ratio_t0_mean']:.4f} -> {out['load_ratio_end_mean']:.4f}", flush=True)
+def _trend(values: xr.DataArray, geometry: np.ndarray, against: xr.DataArray | None = None) -> dict[str, Any]:
+    """A per-realization variable: its value at t = 0, 1 and t_end, and its slope per decade of t (or of the
+    abscissa ``against``), each with its error from independent realizations (and geometries)."""
+    tr = log_trend(values, t_min=1, against=against)
+    v = values.transpose("realization", "t")
+    t = v["t"].values
+    out = {"t0": _estimate(v.sel(t=0).values, geometry), "t1": _estimate(v.sel(t=1).values, geometry),
+           "end": _estimate(v.isel(t=-1).values, geometry), "t_end": float(t[-1]),
+           "slope_per_decade": _estimate(LN10 * tr["slope"].values, geometry),
+           "realizations": int(tr["realizations"]),
+           "not_finite": int((~np.isfinite(v.values)).sum())}
     return out
 
 
+def _curve(values: xr.DataArray) -> dict[str, list[float]]:
+    """Mean and standard error over realizations at every recorded time (for the figure)."""
+    v = values.transpose("realization", "t").values
+    count = np.isfinite(v).sum(axis=0)
+    # A time where no realization has a value (the appendix's estimator between rearrangements) is NaN.
+    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean = np.nanmean(v, axis=0)
+        sem = np.nanstd(v, axis=0, ddof=1) / np.sqrt(np.maximum(count, 1))
+    return {"t": values["t"].values.tolist(), "mean": mean.tolist(), "sem": sem.tolist()}
+
+
+def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry: np.ndarray,
+                 configs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Every number of one point of the study."""
+    p = PARAMS[params]
+    N = _n_nodes(group.kind, size)
+    law = slidernet.load_config(configs[0]).distribution()
+    mu_s_mean = float(law.mean_max(1))  # the law's mean, conditioned on mu_s > mu_d
+    q = ds["mu_eff_realization"]
+    slips = (ds["n"] / N).where(ds["t"] >= 1)
+    point = {
+        "group": group.name, "kind": group.kind, "size": size, "N": N, "params": params,
+        "mu_d": p.mu_d, "std": p.std, "ratio": p.ratio, "overshoot": group.overshoot,
+        "tilt": dict(group.tilt), "rule": group.rule(), "geometries": group.geometries,
+        "realizations": int(ds.sizes["realization"]), "seeds": sorted({c["seed"] for c in configs}),
+        "mu_s_mean": mu_s_mean,
+        "r_mean": mean_sem(ds["n"].isel(t=-1).values / float(ds["t"][-1]))[0],
+        "slips_per_node_end": _estimate(slips.isel(t=-1).values, geometry),
+        "mu_eff": _trend(q, geometry),
+        "sqrtN_excess": _trend(math.sqrt(N) * (q - p.mu_d), geometry),
+        "sqrtN_excess_vs_slips": _trend(math.sqrt(N) * (q - p.mu_d), geometry, against=slips),
+        "law_units": _trend((q - mu_s_mean) / p.std, geometry),
+        "mu_max": _trend(ds["mu_max"], geometry),
+        "mu_eff_at": group.mu_eff_at,
+        # The weakest link: with no prestress, the first node to yield is the weakest of N.
+        "weakest_of_N": float(mean_min_quadrature(law, N)),
+        "curves": {"mu_eff": _curve(q), "sqrtN_excess": _curve(math.sqrt(N) * (q - p.mu_d)),
+                   "slips_per_node": _curve(ds["n"] / N)},
+        "configs": configs,
+    }
+    if "tilt_first_slip" in ds:  # the network tilt test's loads at its first slip and first collective motion
+        point["tilt_first_slip_end"] = _estimate(ds["tilt_first_slip"].isel(t=-1).values, geometry)
+        point["tilt_all_moving_end"] = _estimate(ds["tilt_all_moving"].isel(t=-1).values, geometry)
+    return point
+
+
+def mechanism(kind: str, N: int, preset: Preset) -> dict[str, Any]:
+    """Thresholds and load ratios of every node at t = 0 and t_end, at the base parameters."""
+    group = Group("mechanism", kind, (N,))
+    cfg = point_config(group, "base", N, 0, preset)
+    cfg["realizations"] = preset.realizations
+    law_mean = float(slidernet.load_config(cfg).distribution().mean_max(1))
+    states = node_states(cfg, [0, preset.steps])
+    summary = node_summary(states, law_mean=law_mean)
+    out: dict[str, Any] = {"kind": kind, "N": N, "steps": preset.steps, "realizations": preset.realizations,
+                           "law_mean": law_mean}
+    for name in ("mu_s_shift", "load_ratio"):
+        for label, k in (("t0", 0), ("end", 1)):
+            out[f"{name}_{label}_mean"] = float(summary[f"{name}_mean"].isel(t=k))
+            out[f"{name}_{label}_sem"] = float(summary[f"{name}_sem"].isel(t=k))
+    return out
+
+
+def multiple_testing(points: list[dict[str, Any]]) -> dict[str, Any]:
+    """The family of slope tests (mu_eff per decade, every point): how many pass 2 standard errors, how many
+    would by chance, and the Benjamini-Hochberg adjusted p-values."""
+    tests = [(i, pt["mu_eff"]["slope_per_decade"]) for i, pt in enumerate(points)]
+    tests = [(i, s) for i, s in tests if math.isfinite(s["p"])]
+    ps = np.array([s["p"] for _, s in tests])
+    adjusted = stats.false_discovery_control(ps) if ps.size else ps
+    beyond_2se = sum(abs(s["mean"]) > 2 * s["sem"] for _, s in tests)
+    by_chance = sum(2 * stats.t.sf(2.0, s["dof"]) for _, s in tests)
+    for (i, _), q in zip(tests, adjusted, strict=True):
+        points[i]["mu_eff"]["slope_per_decade"]["q_bh"] = float(q)
+    return {"tests": len(tests), "beyond_2_se": int(beyond_2se), "expected_by_chance": float(by_chance),
+            "significant_at_q_0.05": int((adjusted < 0.05).sum()),
+            "method": "two-sided Student-t p-values of each slope (dof: realizations - 1, or geometries - 1); "
+                      "Benjamini-Hochberg (scipy.stats.false_discovery_control)"}
+
+
+def _sizes_axis(ax: Any, sizes: Sequence[int]) -> None:
+    """A log axis of numbers of sliders, ticked at the sizes drawn."""
+    ax.set_xscale("log")
+    ax.set_xticks(sorted(set(sizes)), [str(n) for n in sorted(set(sizes))])
+    ax.minorticks_off()
+
+
+def _label(pt: dict[str, Any]) -> str:
+    return {"pair": "pair", "chain": f"chain {pt['N']}", "irregular": f"irregular {pt['N']}",
+            "triangular": f"triangular {pt['size']}x{pt['size']}"}[pt["kind"]]
+
+
 def plot(data: dict[str, Any], path: Path) -> Path:
-    """mu_eff(t) per size, slopes and the x_G^2 prefactor against N, mechanism; written atomically to ``path``."""
-    fig = Figure(figsize=(11, 8.5), layout="constrained")
+    """mu_eff(t), its scaled excess against the slips per node, slopes against N, and the two rule scans."""
+    fig = Figure(figsize=(15, 9), layout="constrained")
     FigureCanvasAgg(fig)
-    (ax_t, ax_s), (ax_x, ax_m) = fig.subplots(2, 2)
-    # The replica (another seed) is drawn on its own in panel (b), not as a second curve.
-    replica = [p for p in data["points"] if p["group"] == "chains_replica"]
-    first = [p for p in data["points"] if p["group"] != "chains_replica"]
-    base = [p for p in first if p["std"] == 0.01 and p["sigma_theta_over_Ntilde"] == 1.0]
+    axes = fig.subplots(2, 3)
+    (ax_t, ax_s, ax_n), (ax_scaled, ax_e, ax_c) = axes
+    pts = data["points"]
+    main = [p for p in pts if p["overshoot"] == 1.0 and not p["tilt"] and p["mu_eff_at"] == "records"]
+    base = [p for p in main if p["params"] == "base"]
+    style = {"pair": "*-", "chain": "o-", "irregular": "s-", "triangular": "^--"}
     for c, p in enumerate(base):
-        cur = p["curves"]["mu_eff"]
-        t, m, s = np.array(cur["t"], float), np.array(cur["mean"]), np.array(cur["sem"])
+        cur = p["curves"]
+        t, m, s = (np.array(cur["mu_eff"][k], float) for k in ("t", "mean", "sem"))
         keep = t >= 1
-        ax_t.errorbar(t[keep], m[keep], yerr=s[keep], fmt="o-" if p["kind"] == "chain" else "s--", ms=3,
-                      color=f"C{c % 10}", label=f"{p['kind']} {p['n']}", lw=0.8)
-        # t = 0 cannot sit on a log axis: its mean is marked on the left edge.
-        ax_t.plot([0], [p["mu_eff"]["t0_mean"]], ">", color=f"C{c % 10}", ms=7, clip_on=False,
-                  transform=ax_t.get_yaxis_transform())
-    ax_t.axhline(data["parameters"]["mu_d"], color="k", lw=0.6, ls=":")
+        ax_t.errorbar(t[keep], m[keep], yerr=s[keep], fmt=style[p["kind"]], ms=3, lw=0.8, color=f"C{c % 10}",
+                      label=_label(p))
+        x = np.array(cur["slips_per_node"]["mean"])[keep]
+        y, ys = (np.array(cur["sqrtN_excess"][k])[keep] for k in ("mean", "sem"))
+        ax_s.errorbar(x, y, yerr=ys, fmt=style[p["kind"]], ms=3, lw=0.8, color=f"C{c % 10}", label=_label(p))
+    ax_t.axhline(PARAMS["base"].mu_d, color="k", lw=0.6, ls=":")
     ax_t.set_xscale("log")
-    ax_t.set_xlabel(r"$t$  [$\tau_\mathrm{th}$]")
-    ax_t.set_ylabel(r"$\mu_\mathrm{eff}$ (tilt test at recorded times)")
-    ax_t.set_title(r"(a) $\sigma_\mu/(\bar\mu_s-\mu_d) = 0.1$, $\sigma_\theta/\tilde N = 1$; "
-                   r"mean $\pm$ SE; $\triangleright$: t = 0", fontsize=9)
-    ax_t.legend(fontsize=7, ncol=2)
-
-    markers = {("chain", 1.0): "o", ("irregular", 1.0): "s", ("chain", 10.0): "^", ("irregular", 10.0): "D"}
-    for (kind, ratio), mk in markers.items():
-        for k, std in enumerate((0.01, 0.02, 0.03)):
-            pts = [p for p in first if p["kind"] == kind and p["sigma_theta_over_Ntilde"] == ratio
-                   and p["std"] == std]
-            if not pts:
-                continue
-            n = np.array([p["n"] for p in pts], float)
-            lab = f"{kind}, std {std}, " + rf"$\sigma_\theta/\tilde N$ = {ratio:g}"
-            ax_s.errorbar(n * (1 + 0.04 * k), [p["mu_eff"]["slope_per_decade_mean"] for p in pts],
-                          yerr=[p["mu_eff"]["slope_per_decade_sem"] for p in pts], fmt=mk + "-", ms=4,
-                          color=f"C{k}", mfc="none" if ratio == 10.0 else None, label=lab, lw=0.8)
-            if std == 0.01:
-                ax_x.errorbar(n, [p["x_G2"]["slope_per_ln_t_mean"] for p in pts],
-                              yerr=[p["x_G2"]["slope_per_ln_t_sem"] for p in pts], fmt=mk + "-", ms=4,
-                              color="C0" if ratio == 1.0 else "C3",
-                              label=f"{kind}, " + rf"$\sigma_\theta/\tilde N$ = {ratio:g}")
-    if replica:
-        ax_s.errorbar([p["n"] * 0.96 for p in replica], [p["mu_eff"]["slope_per_decade_mean"] for p in replica],
-                      yerr=[p["mu_eff"]["slope_per_decade_sem"] for p in replica], fmt="*", ms=7, color="k",
-                      label=f"chain, std 0.01, replica (seed {replica[0]['seed']}, "
-                            f"{replica[0]['realizations']} realizations)")
-    ax_s.axhline(0, color="k", lw=0.6)
+    ax_t.set_xlabel(r"$t$ [$\tau_\mathrm{th}$]")
+    ax_t.set_ylabel(r"$\mu_\mathrm{eff}$")
+    ax_t.set_title(r"(a) base: $\sigma_\mu/(\bar\mu_s-\mu_d) = 0.1$, $\mu_d = 0.5$; mean $\pm$ SE", fontsize=9)
+    ax_t.legend(fontsize=6, ncol=2)
     ax_s.set_xscale("log")
-    ax_s.set_xlabel("number of sliders N")
-    ax_s.set_ylabel(r"$d\mu_\mathrm{eff}/d\log_{10} t$ (per decade)")
-    ax_s.set_title("(b) aging rate of the tilt-test friction", fontsize=9)
-    ax_s.legend(fontsize=6)
-    ax_x.set_xscale("log")
-    ax_x.set_yscale("log")
-    ax_x.set_xlabel("number of sliders N")
-    ax_x.set_ylabel(r"$d\langle x_G^2\rangle/d\ln t$  [$l_0^2$]")
-    ax_x.set_title(r"(c) diffusion prefactor of the centre of mass", fontsize=9)
-    ax_x.legend(fontsize=7)
-
-    mech = data["mechanism"]
-    labels = [f"{m['kind'][:5]} {m['n']}" for m in mech]
-    x = np.arange(len(mech))
-    # Four markers per network, grouped about its tick; the limits keep a lone network in the middle
-    # (with one network, the autoscaled axis spread the markers over the whole width).
-    for k, (label, key) in enumerate((("t = 0", "t0"), ("end", "end"))):
-        ax_m.errorbar(x - 0.15 + 0.1 * k, [m[f"mu_s_shift_{key}_mean"] for m in mech],
-                      yerr=[m[f"mu_s_shift_{key}_sem"] for m in mech], fmt="o", color=f"C{k}",
-                      label=r"$\langle\mu_s\rangle - $ law mean, " + label)
-    ax_m.axhline(0, color="k", lw=0.6)
-    ax_m.set_xticks(x, labels, fontsize=8)
-    ax_m.set_xlim(-0.5, len(mech) - 0.5)
-    ax_m.set_ylabel("threshold shift (selection)")
-    ax_r = ax_m.twinx()
-    for k, (label, key) in enumerate((("t = 0", "t0"), ("end", "end"))):
-        ax_r.errorbar(x + 0.05 + 0.1 * k, [m[f"load_ratio_{key}_mean"] for m in mech],
-                      yerr=[m[f"load_ratio_{key}_sem"] for m in mech], fmt="s", color=f"C{k + 2}",
-                      label=r"load ratio $|F|/(\mu_s N)$, " + label)
-    ax_r.set_ylabel("mean load ratio (prestress)")
-    ax_m.set_title("(d) mechanism: circles selection (left), squares prestress (right)", fontsize=9)
-    h1, l1 = ax_m.get_legend_handles_labels()
-    h2, l2 = ax_r.get_legend_handles_labels()
-    ax_m.legend(h1 + h2, l1 + l2, fontsize=6, loc="center right")
-    return save_figure(fig, path, dpi=120)
+    ax_s.set_xlabel("slips per node")
+    ax_s.set_ylabel(r"$\sqrt{N}\,(\mu_\mathrm{eff} - \mu_d)$")
+    ax_s.set_title("(b) the excess over $\\mu_d$ in units of $1/\\sqrt{N}$, base", fontsize=9)
+    markers = {"pair": "*", "chain": "o", "irregular": "s", "triangular": "^"}
+    for k, params in enumerate(PARAMS):
+        for kind, mk in markers.items():
+            sel = [p for p in main if p["params"] == params and p["kind"] == kind]
+            if not sel:
+                continue
+            n = np.array([p["N"] for p in sel], float) * (1 + 0.05 * (k - 1))
+            for ax, key in ((ax_n, "mu_eff"), (ax_scaled, "sqrtN_excess")):
+                sl = [p[key]["slope_per_decade"] for p in sel]
+                ax.errorbar(n, [s["mean"] for s in sl], yerr=[s["sem"] for s in sl], fmt=mk, ms=5, color=f"C{k}",
+                            label=f"{kind}, {params}" if ax is ax_n else None, mfc="none" if kind != "irregular"
+                            else None)
+    for ax, unit in ((ax_n, r"$d\mu_\mathrm{eff}/d\log_{10}t$"),
+                     (ax_scaled, r"$d[\sqrt{N}(\mu_\mathrm{eff}-\mu_d)]/d\log_{10}t$")):
+        ax.axhline(0, color="k", lw=0.6)
+        _sizes_axis(ax, [p["N"] for p in main])
+        ax.set_xlabel("number of sliders N")
+        ax.set_ylabel(unit + " (per decade)")
+    ax_n.set_title("(c) aging rate of $\\mu_\\mathrm{eff}$, three parameter sets", fontsize=9)
+    ax_n.legend(fontsize=6, ncol=2)
+    ax_scaled.set_title("(d) the same, scaled by $\\sqrt{N}$", fontsize=9)
+    for ax, pick, title in (
+        (ax_e, lambda p: not p["tilt"], "(e) the slip's overshoot e: $\\mu_\\mathrm{eff}$ at $t_\\mathrm{end}$"),
+        (ax_c, lambda p: True, "(f) sliding rules at e = 1 and e = 0: $\\mu_\\mathrm{eff}$ at $t_\\mathrm{end}$"),
+    ):
+        rules = sorted({p["rule"] for p in pts if pick(p) and (p["kind"] in ("pair", "irregular"))
+                        and p["mu_eff_at"] == "records" and (ax is ax_e or p["overshoot"] in (0.0, 1.0))})
+        for k, rule in enumerate(rules):
+            for j, params in enumerate(("base", "ratio0.3")):
+                sel = sorted((p for p in pts if p["rule"] == rule and p["params"] == params and pick(p)
+                              and p["kind"] in ("pair", "irregular")), key=lambda p: p["N"])
+                if not sel:
+                    continue
+                n = np.array([p["N"] for p in sel], float) * (1 + 0.04 * k)
+                ax.errorbar(n, [p["mu_eff"]["end"]["mean"] for p in sel],
+                            yerr=[p["mu_eff"]["end"]["sem"] for p in sel], fmt="o-" if j == 0 else "s--", ms=4,
+                            lw=0.8, color=f"C{k}", label=f"{rule}, {params}")
+        ax.axhline(0.5, color="k", lw=0.6, ls=":")
+        _sizes_axis(ax, [p["N"] for p in pts if p["kind"] in ("pair", "irregular")])
+        ax.set_xlabel("number of sliders N (pair and irregular)")
+        ax.set_ylabel(r"$\mu_\mathrm{eff}(t_\mathrm{end})$")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=6)
+    return save_figure(fig, path, dpi=110)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -399,8 +472,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="a small grid, short runs (seconds); "
                         "the same as --preset quick")
     parser.add_argument("--preset", choices=sorted(PRESETS), default="full",
-                        help="full (the study, about 9 min on 2 cores), quick, or large (4096 sliders, "
-                             "beyond the full preset's budget)")
+                        help="full (the study), quick, or large (4096 sliders, beyond the full preset's budget)")
     parser.add_argument("--workers", type=int, default=None, help="worker processes per sweep point")
     parser.add_argument("--scheduler", default=None,
                         help="a Dask scheduler address, e.g. tcp://host:8786: realizations run on that cluster")
@@ -411,31 +483,41 @@ def main(argv: Sequence[str] | None = None) -> int:
     name = "quick" if args.quick else args.preset
     preset = PRESETS[name]
     start = time.perf_counter()
-    base = base_config(preset.realizations)
     points: list[dict[str, Any]] = []
     for group in preset.groups:
-        points += run_group(group, preset.realizations, args.workers, args.out, args.resume,
-                            scheduler=args.scheduler)
-    mech = [mechanism(kind, n, steps, preset.realizations) for kind, n, steps in preset.mechanism]
+        for params in group.params:
+            t0 = time.perf_counter()
+            for size, (ds, geometry, configs) in zip(group.sizes, run_sweeps(
+                    group, params, preset, args.workers, args.scheduler, args.out, args.resume), strict=True):
+                pt = reduce_point(group, params, size, ds, geometry, configs)
+                points.append(pt)
+                e, s = pt["mu_eff"], pt["mu_eff"]["slope_per_decade"]
+                print(f"{group.name} {params} N={pt['N']}: mu_eff {e['t0']['mean']:.4f} -> "
+                      f"{e['end']['mean']:.4f}, slope/decade {s['mean']:+.5f} +- {s['sem']:.5f} (dof {s['dof']})",
+                      flush=True)
+            print(f"{group.name} {params}: {time.perf_counter() - t0:.1f} s", flush=True)
+    family = multiple_testing(points)
+    mech = [mechanism(kind, N, preset) for kind, N in preset.mechanism]
     data = {
-        "question": "does thermal cycling increase mu_eff with time in networks of sliders?",
+        "question": "does thermal cycling increase mu_eff with time in networks of sliders, where the pair ages?",
         "preset": name,
-        "estimator": "network tilt test at every recorded time (mu_eff_at = 'records'), same at every size; "
-                     "trends: log_trend (per-realization slopes vs ln t, t >= 1; errors from their spread)",
-        "parameters": {"mu_d": base["friction"]["mu_d"], "mu_s_mean": base["friction"]["static"]["mean"],
-                       "Ntilde": base["network"]["Ntilde"], "seed": base["seed"],
-                       "realizations": preset.realizations, "irregular_network_seed": 0},
-        "base_config": base,
-        "groups": [dataclasses.asdict(g) for g in preset.groups],
+        "estimator": "network tilt test at every recorded time (mu_eff_at = 'records'), the same at every size; "
+                     "trends: log_trend, per-realization slopes against ln t for t >= 1; errors from independent "
+                     "realizations, and for irregular networks from the spread of the geometries' means",
+        "parameters": {key: dataclasses.asdict(p) | {"ratio": p.ratio} for key, p in PARAMS.items()},
+        "preset_settings": {"realizations": preset.realizations, "steps": preset.steps,
+                            "per_decade": preset.per_decade, "sigma_theta_over_Ntilde": 1.0,
+                            "groups": [dataclasses.asdict(g) for g in preset.groups]},
+        "multiple_testing": family,
         "points": points,
         "mechanism": mech,
         "slidernet_version": slidernet.__version__,
-        "wall_time_s": None,
     }
     data["wall_time_s"] = time.perf_counter() - start
     print(write_json(data, args.out / JSON_NAME))
     print(plot(data, args.out / PNG_NAME))
-    print(f"done in {time.perf_counter() - start:.1f} s")
+    print(f"{family['beyond_2_se']} of {family['tests']} slopes beyond 2 standard errors "
+          f"({family['expected_by_chance']:.1f} expected by chance); done in {time.perf_counter() - start:.1f} s")
     return 0
 
 

@@ -134,28 +134,40 @@ def test_incline_creep_quick(tmp_path):
 
 
 def test_aging_networks_quick(tmp_path):
-    """The --quick preset (chains of 2 and 4, irregular 16; 4 realizations, seed 1; ~10 s): numbers with errors."""
+    """The --quick preset (pair, chain 4, irregular 16 over 2 geometries, triangular 4 x 4, the overshoot and
+    a stricter sliding rule; 4 realizations; ~10 s): numbers with errors from independent units."""
     study, data = run_quick_study("aging_networks", tmp_path)
     preset = study.PRESETS["quick"]
-    assert len(data["points"]) == sum(len(g.sizes) * len(g.stds) for g in preset.groups)
+    assert len(data["points"]) == sum(len(g.sizes) * len(g.params) for g in preset.groups)
     for p in data["points"]:
-        assert p["config"]["mu_eff_at"] == "records"
-        for name in ("mu_eff", "mu_max", "x_G2"):
-            tr = p[name]
-            assert tr["realizations"] == preset.realizations
-            assert tr["slope_per_ln_t_sem"] > 0 and math.isfinite(tr["slope_per_ln_t_mean"])
-            assert tr["t_end"] == p["steps"]
-        # The tilt test gives a friction above mu_d, and mu_max stands above it.
-        assert 0.5 < p["mu_eff"]["end_mean"] < p["mu_max"]["end_mean"]
-        # Its first slip comes first, the collective motion later, sliding last
-        # (per test, so for the means too); unstressed at t = 0, the three coincide
-        # for every chain (checked per realization in tests/test_mechanism.py).
-        first, moving, eff = p["tilt_first_slip"], p["tilt_all_moving"], p["mu_eff"]
-        assert first["end_mean"] <= moving["end_mean"] <= eff["end_mean"]
-        assert moving["realizations"] == preset.realizations
-        assert 0.0 <= p["all_moving_below_mu_d"]["mean"] <= 1.0
-        if p["kind"] == "chain":
-            assert first["t0_mean"] == moving["t0_mean"] == eff["t0_mean"]
+        assert all(c["mu_eff_at"] == p["mu_eff_at"] for c in p["configs"])
+        assert p["realizations"] == preset.realizations
+        slope = p["mu_eff"]["slope_per_decade"]
+        # Errors from independent units: the geometries of an irregular network, else the realizations.
+        assert slope["dof"] == (p["geometries"] - 1 if p["kind"] == "irregular" else preset.realizations - 1)
+        assert slope["sem"] > 0 and math.isfinite(slope["mean"]) and 0 <= slope["p"] <= 1
+        assert p["mu_eff"]["t_end"] == preset.steps
+        # The records' estimator has a value at every time; the appendix's only where a rearrangement was.
+        if p["mu_eff_at"] == "records":
+            assert p["mu_eff"]["not_finite"] == 0
+        else:
+            assert p["mu_eff"]["not_finite"] < p["realizations"] * len(p["curves"]["mu_eff"]["t"])
+        # The tilt test gives a friction above mu_d, below the strongest threshold; its first slip comes
+        # first and the collective motion before the sliding (per test, so for the means too).
+        end = p["mu_eff"]["end"]["mean"]
+        assert p["mu_d"] < end < p["mu_max"]["end"]["mean"]
+        if p["mu_eff_at"] == "records":
+            assert p["tilt_first_slip_end"]["mean"] <= p["tilt_all_moving_end"]["mean"] <= end
+        # The weakest of N thresholds lies below the law's mean, and the more so the larger N.
+        assert p["weakest_of_N"] < p["mu_s_mean"]
+        assert math.isclose(p["sqrtN_excess"]["end"]["mean"], math.sqrt(p["N"]) * (end - p["mu_d"]), rel_tol=1e-9)
+    points = {(p["group"], p["params"], p["N"]): p for p in data["points"]}
+    # Slips that stop at mu_d (e = 0) leave a higher mu_eff than the paper's slip (measured: 0.560 against
+    # 0.511, errors below 0.003).
+    assert points[("irregular_e0", "base", 16)]["mu_eff"]["end"]["mean"] > \
+        points[("irregular", "base", 16)]["mu_eff"]["end"]["mean"] + 0.02
+    family = data["multiple_testing"]
+    assert family["tests"] == len(data["points"]) and 0 <= family["beyond_2_se"] <= family["tests"]
     (mech,) = data["mechanism"]
     # At rest at t = 0 no spring is stretched: load ratio 0; thermal cycling loads the nodes.
     assert mech["load_ratio_t0_mean"] == 0.0
