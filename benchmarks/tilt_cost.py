@@ -2,6 +2,7 @@
 
     python benchmarks/tilt_cost.py [--sizes 100 1000 10000] [--lattices 10 32] [--realizations 8]
                                    [--tests 2] [--age 3] [--seed 1] [--core 0] [--max-avalanche S]
+                                   [--overshoot E] [--min-slips M] [--min-displacement X]
                                    [--csv PATH] [--quick]
 
 The network tilt test (:meth:`slidernet.solver.Realization.tilt_test`, kernel
@@ -74,6 +75,13 @@ out cost at least ``solver.max_avalanche`` slips). ``--quick`` is a smoke
 run of a few seconds (irregular 100 and 1000 nodes, lattice 10 x 10, 4
 realizations of one test each, age 2). ``--csv PATH`` writes one line per
 size with the numbers unformatted.
+
+The sliding rule and the slip rule are those of the configuration keys:
+``--overshoot E`` is ``friction.overshoot`` (default: the paper's e = 1),
+``--min-slips M`` and ``--min-displacement X`` are ``[tilt] min_slips`` and
+``min_displacement`` (defaults 1 and 0, the rule of every earlier result).
+A stricter rule costs more slips per test; run the script once per rule to
+compare (the rule is printed in the first line).
 """
 
 from __future__ import annotations
@@ -124,7 +132,8 @@ def network_table(kind: str, size: int) -> dict[str, Any]:
     return {"kind": "triangular", "shape": [size, size], "Ntilde": NTILDE}
 
 
-def run_config(network: dict[str, Any], age: int, max_avalanche: int | None) -> dict[str, Any]:
+def run_config(network: dict[str, Any], age: int, max_avalanche: int | None,
+               rule: dict[str, float] | None = None) -> dict[str, Any]:
     """The configuration of the scene: ``age`` thermal steps, no observable that makes tilt tests itself.
 
     Parameters
@@ -135,6 +144,9 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None) -> 
         Thermal steps of the realizations.
     max_avalanche : int or None
         ``solver.max_avalanche`` (also the tilt test's cap on slips); None: the default.
+    rule : dict, optional
+        ``overshoot``, ``min_slips``, ``min_displacement`` (any of them; None
+        values left out): ``friction.overshoot`` and the ``[tilt]`` table.
 
     Returns
     -------
@@ -148,6 +160,11 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None) -> 
     }
     if max_avalanche is not None:
         cfg["solver"] = {"max_avalanche": max_avalanche}
+    rule = {k: v for k, v in (rule or {}).items() if v is not None}
+    if "overshoot" in rule:
+        cfg["friction"] = FRICTION | {"overshoot": rule.pop("overshoot")}
+    if rule:
+        cfg["tilt"] = rule
     return cfg
 
 
@@ -209,7 +226,7 @@ def _rate(done: list[dict[str, Any]]) -> float:
 
 
 def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed: int,
-            max_avalanche: int | None) -> dict[str, Any]:
+            max_avalanche: int | None, rule: dict[str, float] | None = None) -> dict[str, Any]:
     """Tilt tests and thermal steps of ``realizations`` realizations of one network.
 
     Parameters
@@ -228,6 +245,8 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
         The root seed.
     max_avalanche : int or None
         ``solver.max_avalanche``; None: the default.
+    rule : dict, optional
+        The slip and sliding rules (:func:`run_config`); None: the defaults.
 
     Returns
     -------
@@ -243,7 +262,7 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
         resident memory so far).
     """
     t0 = time.perf_counter()
-    scene = Scene.from_config(load_config(run_config(network_table(kind, size), age, max_avalanche)))
+    scene = Scene.from_config(load_config(run_config(network_table(kind, size), age, max_avalanche, rule)))
     setup = time.perf_counter() - t0
     N = scene.network.n_nodes
     per: dict[str, list[float]] = {k: [] for k in FIGURES}
@@ -506,6 +525,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--core", type=int, default=0, help="the core the process is pinned to (default 0)")
     ap.add_argument("--max-avalanche", type=int, default=None,
                     help="solver.max_avalanche, the tilt test's cap on slips (default: the config's, 1e8)")
+    ap.add_argument("--overshoot", type=float, default=None, help="friction.overshoot e in [0, 1] (default 1)")
+    ap.add_argument("--min-slips", type=int, default=None, help="[tilt] min_slips (default 1)")
+    ap.add_argument("--min-displacement", type=float, default=None, help="[tilt] min_displacement (default 0)")
     ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
     ap.add_argument("--quick", action="store_true", help="a smoke run of a few seconds")
     args = ap.parse_args(argv)
@@ -518,14 +540,17 @@ def main(argv: list[str] | None = None) -> int:
     if age < 2 or tests < 1 or realizations < 1:
         ap.error("--age must be at least 2, --tests and --realizations at least 1")
 
+    rule = {"overshoot": args.overshoot, "min_slips": args.min_slips, "min_displacement": args.min_displacement}
+    load_config(run_config(network_table("irregular", 16), 2, None, rule))  # a bad rule: one line, before work
     core = _pick_core(args.core)
     t_start = time.perf_counter()
-    print(f"network tilt test, cost per test; one core = core {core}; load average {os.getloadavg()[0]:.2f}",
-          flush=True)
+    named = ", ".join(f"{k} = {v:g}" for k, v in rule.items() if v is not None) or "the defaults"
+    print(f"network tilt test, cost per test; rule: {named}; one core = core {core}; load average "
+          f"{os.getloadavg()[0]:.2f}", flush=True)
     warm_up()
     rows = []
     for kind, size in [("irregular", n) for n in sizes] + [("triangular", L) for L in lattices]:
-        row = measure(kind, size, realizations, tests, age, args.seed, args.max_avalanche)
+        row = measure(kind, size, realizations, tests, age, args.seed, args.max_avalanche, rule)
         rows.append(row)
         s = summary(row)
         print(f"  {_label(row)}, N = {row['N']:,}: {_pm(s['test_s'], s['test_s_sem'])} s per test, "

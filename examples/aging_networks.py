@@ -42,7 +42,8 @@ exact mean of the weakest of N thresholds
 (:func:`slidernet.plugins.distributions.mean_min_quadrature`).
 
 Writes ``aging_networks.json`` (every number with its parameters and
-configurations) and ``aging_networks.png`` into ``--out``::
+configurations), ``aging_networks_tables.md`` (the guide's tables, made from
+that JSON by ``tables``) and ``aging_networks.png`` into ``--out``::
 
     python examples/aging_networks.py --out aging_out --workers 2                  # the full preset
     python examples/aging_networks.py --out aging_out --quick                      # seconds; CI runs it
@@ -76,7 +77,7 @@ import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
 from slidernet.analysis.trend import grouped_mean_sem, log_trend, mean_sem
 from slidernet.ensemble.sweep import sweep
-from slidernet.io import save_figure, write_json
+from slidernet.io import atomic_output, save_figure, write_json
 from slidernet.plugins.distributions import mean_min_quadrature
 
 try:
@@ -85,6 +86,7 @@ except NameError:  # sphinx-gallery defines no __file__; it runs the script from
     BASE_TOML = Path("aging_networks.toml").resolve()
 JSON_NAME = "aging_networks.json"
 PNG_NAME = "aging_networks.png"
+TABLES_NAME = "aging_networks_tables.md"  # the guide's tables, from the JSON
 LN10 = math.log(10.0)
 MU_S_MEAN = 0.6  # the law's mean before its truncation at mu_d, in every parameter set
 
@@ -341,6 +343,10 @@ def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry:
     if "tilt_first_slip" in ds:  # the network tilt test's loads at its first slip and first collective motion
         point["tilt_first_slip_end"] = _estimate(ds["tilt_first_slip"].isel(t=-1).values, geometry)
         point["tilt_all_moving_end"] = _estimate(ds["tilt_all_moving"].isel(t=-1).values, geometry)
+        first0 = ds["tilt_first_slip"].sel(t=0).values
+        point["tilt_first_slip_t0"] = _estimate(first0, geometry)
+        # The fresh state: the share of realizations whose first slip already set the network sliding.
+        point["first_slip_slides_t0"] = float(np.mean(first0 == q.sel(t=0).values))
     return point
 
 
@@ -376,6 +382,92 @@ def multiple_testing(points: list[dict[str, Any]]) -> dict[str, Any]:
             "significant_at_q_0.05": int((adjusted < 0.05).sum()),
             "method": "two-sided Student-t p-values of each slope (dof: realizations - 1, or geometries - 1); "
                       "Benjamini-Hochberg (scipy.stats.false_discovery_control)"}
+
+
+def _pm(e: dict[str, Any], scale: float = 1.0, digits: int = 4) -> str:
+    """``mean ± sem`` of an estimate, both multiplied by ``scale``."""
+    if not math.isfinite(e["sem"]):
+        return f"{e['mean'] * scale:.{digits}f}"
+    return f"{e['mean'] * scale:.{digits}f} ± {e['sem'] * scale:.{digits}f}"
+
+
+def _slope(e: dict[str, Any], scale: float, digits: int = 1) -> str:
+    """A slope per decade, scaled, with its error, degrees of freedom and its Benjamini-Hochberg q if known."""
+    out = f"{e['mean'] * scale:+.{digits}f} ± {e['sem'] * scale:.{digits}f} ({e['dof']})"
+    return out + (f", q {e['q_bh']:.2f}" if "q_bh" in e else "")
+
+
+def tables(data: dict[str, Any]) -> str:
+    """Every table of the guide's page, in Markdown, from the study's numbers (``aging_networks.json``).
+
+    Errors: one standard error from independent units (the realizations;
+    for irregular networks, the geometries' means), their degrees of
+    freedom in brackets; slopes per decade of t.
+    """
+    pts = data["points"]
+    main = [p for p in pts if p["overshoot"] == 1.0 and not p["tilt"]]
+    lines = ["### Every point, absolute units (1e-4 per decade)", "",
+             "| network | N | σ_μ/(μ̄_s−μ_d), μ_d | estimator | R (G) | slips per node, t_end | μ_eff(0) "
+             "| μ_eff(1) | μ_eff(t_end) | dμ_eff/dlog10 t (dof) | dμ_max/dlog10 t (dof) | NaN |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for p in main:
+        e = p["mu_eff"]
+        lines.append(
+            f"| {_label(p)} | {p['N']} | {p['ratio']:.1f}, {p['mu_d']:.1f} | {p['mu_eff_at']} | "
+            f"{p['realizations']} ({p['geometries']}) | {_pm(p['slips_per_node_end'], 1, 0)} | {_pm(e['t0'])} | "
+            f"{_pm(e['t1'])} | {_pm(e['end'])} | {_slope(e['slope_per_decade'], 1e4)} | "
+            f"{_slope(p['mu_max']['slope_per_decade'], 1e4)} | {e['not_finite']} |")
+    lines += ["", "### Scaled units (records' estimator)", "",
+              "| network | N | σ_μ/(μ̄_s−μ_d), μ_d | √N(μ_eff−μ_d), t = 1 | same, t_end | d/dlog10 t (1e-3) "
+              "| d/dlog10(slips per node) (1e-3) | (μ_eff−μ̄_s)/σ_μ, t_end | d/dlog10 t (1e-2) |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for p in main:
+        if p["mu_eff_at"] != "records":
+            continue
+        x, xs, lu = p["sqrtN_excess"], p["sqrtN_excess_vs_slips"], p["law_units"]
+        lines.append(
+            f"| {_label(p)} | {p['N']} | {p['ratio']:.1f}, {p['mu_d']:.1f} | {_pm(x['t1'])} | {_pm(x['end'])} | "
+            f"{_slope(x['slope_per_decade'], 1e3)} | {_slope(xs['slope_per_decade'], 1e3)} | "
+            f"{_pm(lu['end'], 1, 2)} | {_slope(lu['slope_per_decade'], 1e2)} |")
+    lines += ["", "### The slip rule and the sliding rule (1e-4 per decade)", "",
+              "| rule | network | N | σ_μ/(μ̄_s−μ_d) | μ_eff(1) | μ_eff(t_end) | dμ_eff/dlog10 t (dof) "
+              "| d√N(μ_eff−μ_d)/dlog10 t (1e-3) | NaN |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for p in sorted((p for p in pts if p["mu_eff_at"] == "records" and p["params"] in ("base", "ratio0.3")
+                     and (p["kind"] in ("pair", "irregular") and p["N"] <= 256)),
+                    key=lambda p: (p["params"], p["N"], -p["overshoot"], sorted(p["tilt"].items()))):
+        e = p["mu_eff"]
+        lines.append(
+            f"| {p['rule']} | {_label(p)} | {p['N']} | {p['ratio']:.1f} | {_pm(e['t1'])} | {_pm(e['end'])} | "
+            f"{_slope(e['slope_per_decade'], 1e4)} | {_slope(p['sqrtN_excess']['slope_per_decade'], 1e3)} | "
+            f"{e['not_finite']} |")
+    lines += ["", "### The fresh state: the weakest link, the first slip", "",
+              "| network | N | σ_μ/(μ̄_s−μ_d), μ_d | μ_eff(0) | E[min of N draws] | first slip, t = 0 "
+              "| share whose first slip slides, t = 0 | first slip, t_end | all in motion, t_end |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for p in main:
+        if "tilt_first_slip_t0" not in p:
+            continue
+        lines.append(
+            f"| {_label(p)} | {p['N']} | {p['ratio']:.1f}, {p['mu_d']:.1f} | {_pm(p['mu_eff']['t0'])} | "
+            f"{p['weakest_of_N']:.4f} | {_pm(p['tilt_first_slip_t0'])} | {p['first_slip_slides_t0']:.0%} | "
+            f"{_pm(p['tilt_first_slip_end'])} | {_pm(p['tilt_all_moving_end'])} |")
+    fam = data["multiple_testing"]
+    lines += ["", f"Multiple testing: {fam['tests']} slopes of μ_eff, {fam['beyond_2_se']} beyond 2 standard "
+              f"errors, {fam['expected_by_chance']:.1f} expected by chance; "
+              f"{fam['significant_at_q_0.05']} significant at a Benjamini-Hochberg false discovery rate of 0.05.",
+              ""]
+    if data["mechanism"]:
+        lines += ["### Mechanism (base parameters)", "",
+                  "| network | N | R | ⟨μ_s⟩ − law mean, t = 0 | same, t_end | load ratio, t_end |",
+                  "|---|---|---|---|---|---|"]
+        for m in data["mechanism"]:
+            lines.append(
+                f"| {m['kind']} | {m['N']} | {m['realizations']} | "
+                f"{m['mu_s_shift_t0_mean']:+.5f} ± {m['mu_s_shift_t0_sem']:.5f} | "
+                f"{m['mu_s_shift_end_mean']:+.5f} ± {m['mu_s_shift_end_sem']:.5f} | "
+                f"{m['load_ratio_end_mean']:.3f} ± {m['load_ratio_end_sem']:.3f} |")
+    return "\n".join(lines) + "\n"
 
 
 def _sizes_axis(ax: Any, sizes: Sequence[int]) -> None:
@@ -515,6 +607,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     }
     data["wall_time_s"] = time.perf_counter() - start
     print(write_json(data, args.out / JSON_NAME))
+    with atomic_output(args.out / TABLES_NAME) as tmp:
+        tmp.write_text(tables(data))
+    print(args.out / TABLES_NAME)
     print(plot(data, args.out / PNG_NAME))
     print(f"{family['beyond_2_se']} of {family['tests']} slopes beyond 2 standard errors "
           f"({family['expected_by_chance']:.1f} expected by chance); done in {time.perf_counter() - start:.1f} s")
