@@ -333,3 +333,29 @@ def test_cli_sweep_writes_one_dataset_with_the_swept_dims(tmp_path, capsys):
     assert ds["n"].dims == ("sigma_theta", "mu_d", "realization", "t")
     assert main([*argv[:3], "driver.sigma_theta=1e-7", "--set", "driver.sigma_theta=2", *argv[6:]]) == 2
     assert "given twice" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text", ["[]", "{}"], ids=["list", "empty-object"])
+def test_a_damaged_sweep_json_is_one_line(tmp_path, text):
+    # sweep.json holding [] gave an AttributeError traceback.
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    sweep(BASE, grid, out=tmp_path, **ONE)
+    (tmp_path / "sweep.json").write_text(text)
+    with pytest.raises(CheckpointError, match=r"sweep\.json' does not identify a sweep .*--overwrite"):
+        sweep(BASE, grid, out=tmp_path, resume=True, **ONE)
+
+
+def test_a_sweep_still_going_is_not_touched(tmp_path):
+    # A second sweep in the folder of one still going (even with --overwrite) is refused before it
+    # removes or writes anything.
+    from slidernet.errors import FolderInUseError
+    from slidernet.io.store import FolderLock
+
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    sweep(BASE, grid, out=tmp_path, **ONE)
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    with FolderLock(tmp_path):  # held as the sweep still going holds it
+        for flags in ({"overwrite": True}, {"resume": True}):
+            with pytest.raises(FolderInUseError, match="a slidernet run is still going there"):
+                sweep(BASE, grid, out=tmp_path, **flags, **ONE)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before
