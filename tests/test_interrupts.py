@@ -278,3 +278,85 @@ def test_sigterm_stops_a_realization_inside_a_long_thermal_step(tmp_path):
         assert header["step"] == 0 and header["n"] == 65_536
     _resume(config, out)
     _assert_same_bits(out / "result.nc", tmp_path / "reference" / "result.nc")
+
+
+def _gone(pid: int) -> bool:
+    """True once process ``pid`` has ended (a zombie not yet reaped by its new parent has ended too)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+    return state in ("Z", "X")
+
+
+def _workers_at(gate: Path) -> list[int]:
+    return sorted({int(p.name.split("-")[1]) for p in gate.glob("waiting-*")})
+
+
+def _wait_until_gone(pids: list[int]) -> list[int]:
+    """The processes of ``pids`` still there after a hang guard of 60 s (death by a signal is immediate)."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not all(_gone(p) for p in pids):
+        time.sleep(0.02)
+    return [p for p in pids if not _gone(p)]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_workers_die_with_their_parent(tmp_path, config, reference):
+    # kill -9 of the parent of a 2-worker run left both workers waiting forever (about 220 MB each).
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", "2", gate=gate)
+    _wait_at_gate(gate, proc, 2)
+    workers = _workers_at(gate)
+    assert len(workers) == 2 and proc.pid not in workers
+    os.kill(proc.pid, signal.SIGKILL)  # the parent alone
+    proc.wait()
+    left = _wait_until_gone(workers)
+    for pid in left:  # do not leave them behind when the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f"workers {left} outlived their parent"
+    _assert_consistent(out / "checkpoint")
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+    assert sorted(p.name for p in out.iterdir()) == ["result.nc"]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_killed_worker_is_one_line_and_the_run_resumes(tmp_path, config, reference):
+    # kill -9 of one worker gave a BrokenProcessPool traceback and exit 1.
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", "2", gate=gate)
+    _wait_at_gate(gate, proc, 2)
+    killed, other = _workers_at(gate)
+    os.kill(killed, signal.SIGKILL)
+    (gate / "open").touch()
+    rc, err = _finish(proc)
+    assert rc == 2 and "Traceback" not in err and err.count("\n") == 1, err
+    assert "A worker process was killed by SIGKILL" in err and "0 of 4 realizations are finished and 2 saved " \
+        "in progress" in err and "--resume" in err
+    assert not _wait_until_gone([other]), "the other worker outlived the run"
+    _assert_consistent(out / "checkpoint")
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+
+
+@pytest.mark.slow
+def test_a_second_run_in_the_folder_of_a_run_still_going_is_refused(tmp_path, config, reference):
+    # --resume of a run still going was accepted: every realization was computed twice and the first
+    # run then failed. Without --resume the second run said "holds an interrupted run".
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", "1", gate=gate)
+    _wait_at_gate(gate, proc, 1)
+    try:
+        for flags in (["--resume"], [], ["--overwrite"]):
+            rc, err = _finish(_cli("run", str(config), "--out", str(out), *flags))
+            assert rc == 2 and err.count("\n") == 1, err
+            assert f"a slidernet run is still going there (process {proc.pid} holds its lock" in err
+    finally:
+        (gate / "open").touch()  # the first run goes on to its end, whatever happened
+    rc, err = _finish(proc)
+    assert rc == 0, err
+    _assert_same_bits(out / "result.nc", reference)
+    assert sorted(p.name for p in out.iterdir()) == ["result.nc"]
