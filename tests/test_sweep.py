@@ -359,3 +359,31 @@ def test_a_sweep_still_going_is_not_touched(tmp_path):
             with pytest.raises(FolderInUseError, match="a slidernet run is still going there"):
                 sweep(BASE, grid, out=tmp_path, **flags, **ONE)
     assert sorted(p.name for p in tmp_path.rglob("*")) == before
+
+
+def test_a_finished_point_computed_from_an_input_file_since_changed_is_refused(tmp_path, monkeypatch):
+    # The finished points of a killed sweep are read back on resume: one computed from a data file that
+    # has changed since would be stacked beside points computed from the new contents.
+    from slidernet.plugins.contract import example_file
+
+    data = tmp_path / "mu_s.txt"
+    data.write_text(open(example_file("mu_s_example.txt")).read())
+    base = with_values(BASE, **{"friction.static": {"name": "empirical", "path": str(data)}})
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    real_run = runner.run
+    calls: list[int] = []
+
+    def killed_at_point_1(cfg, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real_run(cfg, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run", killed_at_point_1)
+    with pytest.raises(RunInterrupted, match="1 of 2 sweep points are done"):
+        sweep(base, grid, out=tmp_path / "out", **ONE)
+    monkeypatch.setattr(runner, "run", real_run)
+    data.write_text(data.read_text() + "0.7\n")
+    with pytest.raises(CheckpointError, match=r"points/0/result\.nc' was computed from other contents of the "
+                                              rf"input files than they hold now: '{re.escape(str(data))}'"):
+        sweep(base, grid, out=tmp_path / "out", resume=True, **ONE)
