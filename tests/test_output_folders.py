@@ -467,14 +467,20 @@ sys.stdin.read()
 """
 
 
-@pytest.fixture
-def locked_by_another_process(tmp_path) -> Iterator[tuple[Path, subprocess.Popen]]:
-    """``tmp_path / "out"``, locked by another process (which waits until the test ends)."""
-    out = tmp_path / "out"
-    out.mkdir()
-    holder = subprocess.Popen([sys.executable, "-c", _HOLD_LOCK, str(out)], stdin=subprocess.PIPE,
+def _hold_lock(folder: Path) -> subprocess.Popen:
+    """Another process that holds ``folder``'s lock, as a run still going does, until it is killed."""
+    holder = subprocess.Popen([sys.executable, "-c", _HOLD_LOCK, str(folder)], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, text=True)
     assert holder.stdout.readline() == "locked\n"
+    return holder
+
+
+@pytest.fixture
+def interrupted_and_locked(tmp_path) -> Iterator[tuple[Path, subprocess.Popen]]:
+    """An interrupted run in ``tmp_path / "out"``, whose lock another process holds."""
+    out = tmp_path / "out"
+    _stopped_after(CHAIN8, out, 1)
+    holder = _hold_lock(out / "checkpoint")
     yield out, holder
     holder.kill()
     holder.wait()
@@ -482,12 +488,10 @@ def locked_by_another_process(tmp_path) -> Iterator[tuple[Path, subprocess.Popen
 
 @pytest.mark.parametrize("flags", [{"resume": True}, {}, {"overwrite": True}],
                          ids=["resume", "plain", "overwrite"])
-def test_a_run_still_going_is_refused_whatever_the_flags(locked_by_another_process, flags):
+def test_a_run_still_going_is_refused_whatever_the_flags(interrupted_and_locked, flags):
     # A --resume started while the same run was still going was accepted: all the work was done twice
     # and the first run then failed; without --resume it said "holds an interrupted run".
-    out, holder = locked_by_another_process
-    _stopped_after(CHAIN8, out / "elsewhere", 1)  # an interrupted run, to be moved under the lock
-    shutil.move(out / "elsewhere" / "checkpoint", out / "checkpoint")
+    out, holder = interrupted_and_locked
     before = _tree(out)
     with pytest.raises(FolderInUseError, match=rf"a slidernet run is still going there \(process {holder.pid} "
                                                r"holds its lock"):
@@ -495,12 +499,12 @@ def test_a_run_still_going_is_refused_whatever_the_flags(locked_by_another_proce
     assert _tree(out) == before
 
 
-def test_a_lock_dies_with_its_process(locked_by_another_process, chain8_reference):
-    out, holder = locked_by_another_process
+def test_a_lock_dies_with_its_process(interrupted_and_locked, chain8_reference):
+    out, holder = interrupted_and_locked
     holder.kill()  # kill -9: the operating system lets the lock go
     holder.wait()
-    assert (out / ".slidernet.lock").exists()
-    with slidernet.run(CHAIN8, out=out) as ds:
+    assert (out / "checkpoint" / ".slidernet.lock").exists()
+    with slidernet.run(CHAIN8, out=out, resume=True) as ds:
         _assert_same_bits(ds.load(), chain8_reference)
     assert _tree(out) == ["result.nc"]  # the lock file goes with its run
 

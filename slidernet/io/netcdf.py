@@ -46,6 +46,7 @@ import math
 import numbers
 import os
 import re
+import shutil
 import tempfile
 import zlib
 from collections.abc import Iterable, Iterator, Mapping, Sequence
@@ -85,7 +86,7 @@ _TEMPORARY = re.compile(r"\.(?P<target>.+)\.[A-Za-z0-9_]{8}\.tmp")
 
 
 def remove_temporaries(folder: str | Path) -> list[Path]:
-    """Remove what :func:`atomic_output` left in ``folder`` when its process was killed (kill -9, power loss).
+    """Remove what :func:`atomic_output` (or a folder's removal) left in ``folder`` when its process was killed.
 
     A process that dies in the middle of a write cannot remove its temporary
     file. Call this only while no other process writes in ``folder``: the
@@ -99,9 +100,12 @@ def remove_temporaries(folder: str | Path) -> list[Path]:
     folder = Path(folder)
     if not folder.is_dir():
         return []
-    removed = [p for p in folder.iterdir() if _TEMPORARY.fullmatch(p.name) and p.is_file()]
+    removed = [p for p in folder.iterdir() if _TEMPORARY.fullmatch(p.name)]
     for p in removed:
-        p.unlink(missing_ok=True)
+        if p.is_dir():  # a checkpoint folder being removed (slidernet.io.store.RunStore.remove)
+            shutil.rmtree(p, ignore_errors=True)
+        else:
+            p.unlink(missing_ok=True)
     return removed
 
 

@@ -3,8 +3,8 @@
 Layout of an output directory ``DIR`` while its run is unfinished (plain
 numeric files and JSON; no pickle)::
 
-    .slidernet.lock          the folder's lock, while a process works in it (FolderLock)
     checkpoint/
+      .slidernet.lock        the run's lock, while a process works on it (FolderLock)
       run.json               the run's identity: the configuration (without its
                              execution table), the resolved seed, the number of
                              realizations, the slidernet version, the SHA-256 of
@@ -36,6 +36,7 @@ import hashlib
 import json
 import os
 import re
+import secrets
 import shutil
 import warnings
 from collections.abc import Iterator, Mapping
@@ -105,7 +106,7 @@ def file_digest(path: str | Path) -> str:
 
 
 class FolderLock:
-    """An advisory lock on a folder that a run (or a sweep) works in: one process at a time.
+    """An advisory lock on a folder that a run (its checkpoint folder) or a sweep works in: one process at a time.
 
     ``flock`` on the file ``folder/.slidernet.lock``, opened for writing (so
     that NFS, which emulates it with byte-range locks, locks it too). The
@@ -270,7 +271,10 @@ class RunStore:
         self.overwrite = overwrite
         self._buffer: dict[int, Record] = {}
         self._created: list[Path] = []  # folders this run made, outermost first (undone by abandon)
-        self._lock = FolderLock(self.dir.parent)
+        self._wrote_identity = False  # run.json written by this run (undone by abandon)
+        # The lock lives in the checkpoint folder, so that removing the folder at the end of the run
+        # (one rename, remove) also ends the lock: a finished run leaves no lock file behind.
+        self._lock = FolderLock(self.dir)
 
     @property
     def digest(self) -> str:
@@ -303,28 +307,32 @@ class RunStore:
         """
         out = self.dir.parent
         check_output_dir(out)
-        self._make_dirs(out)
+        existed = self.dir.is_dir()
+        self._make_dirs(self.dir)
         try:
             self._lock.acquire()
         except BaseException:
             self.abandon()
             raise
         try:
-            return self._open_locked()
+            return self._open_locked(existed)
         except BaseException:
             self.abandon()
             self.close()
             raise
 
-    def _open_locked(self) -> int:
+    def _open_locked(self, existed: bool) -> int:
+        """:meth:`open` under the lock; ``existed``: the checkpoint folder was there before."""
         out = self.dir.parent
         # Under the lock no other process writes here: a temporary file is what a killed one left.
         remove_temporaries(out)
         remove_temporaries(self.dir)
         run_json = self.dir / "run.json"
         result = out / "result.nc"
-        if self.overwrite and not self.resume and self.dir.exists():
-            shutil.rmtree(self.dir)  # asked for: whatever run was there is replaced
+        if self.overwrite and not self.resume:
+            for path in self.dir.iterdir():  # asked for: whatever run was there is replaced (the lock stays)
+                if path != self._lock.path:
+                    shutil.rmtree(path) if path.is_dir() else path.unlink()
         if run_json.exists():
             stored = _read_identity(run_json)
             if not self.resume:
@@ -344,7 +352,7 @@ class RunStore:
                 "the run's identity: they cannot be matched to a configuration and are never read. Start again "
                 "with --overwrite, or use another output directory.")
         if self.resume:
-            if self.dir.exists():
+            if existed:
                 why = "its checkpoint folder holds no run (no run.json, no saved realization)"
             else:
                 why = "it has no checkpoint folder" + (" (its run is finished: result.nc is there)"
@@ -355,13 +363,13 @@ class RunStore:
                 f"{str(out)!r} holds a finished result ({str(result)!r}); it is not replaced silently. "
                 "Use --overwrite to replace it, or another output directory."
             )
-        self._make_dirs(self.dir)
         self.identity["digest"] = self.digest
         try:
             with atomic_output(run_json) as tmp:
                 tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
         except OSError as exc:
             raise OutputError(f"Cannot write in the output directory {str(out)!r}: {reason(exc)}.") from None
+        self._wrote_identity = True
         return int(self.identity["seed"])
 
     def _check_same_run(self, stored: dict[str, Any]) -> None:
@@ -438,6 +446,9 @@ class RunStore:
         """
         if self._saved_files():
             return
+        if self._wrote_identity:
+            (self.dir / "run.json").unlink(missing_ok=True)
+            self._wrote_identity = False
         for path in reversed(self._created):
             shutil.rmtree(path, ignore_errors=True)
         self._created.clear()
@@ -536,8 +547,19 @@ class RunStore:
             yield cache[path][row]
 
     def remove(self) -> None:
-        """Delete the folder (the run's result is safely written)."""
-        shutil.rmtree(self.dir, ignore_errors=True)
+        """Delete the folder (the run's result is safely written), lock file included.
+
+        The folder is first renamed to a temporary name, in one step: from
+        then on no process sees a run in ``out_dir`` but the finished one,
+        and a kill while the files are removed leaves a temporary folder,
+        removed by the next run there (:func:`~slidernet.io.netcdf.remove_temporaries`).
+        """
+        gone = self.dir.with_name(f".{self.dir.name}.{secrets.token_hex(4)}.tmp")
+        try:
+            os.rename(self.dir, gone)
+        except FileNotFoundError:
+            return
+        shutil.rmtree(gone, ignore_errors=True)
 
 
 def read_identity_file(path: Path, types: Mapping[str, type], what: str) -> dict[str, Any]:
