@@ -6,6 +6,7 @@ import copy
 import importlib
 import json
 import re
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -273,19 +274,25 @@ def test_out_folder_holds_every_point_and_the_result(tmp_path):
     assert replaced["sigma_theta"].values.tolist() == [2e-7, 1e-6]
 
 
+def _killed_at_point(k: int) -> Callable[..., xr.Dataset]:
+    """``runner.run`` that raises KeyboardInterrupt, as Ctrl-C would, when point ``k`` (from 0) starts."""
+    real_run = runner.run
+    calls: list[int] = []
+
+    def run(cfg, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == k + 1:
+            raise KeyboardInterrupt
+        return real_run(cfg, *args, **kwargs)
+
+    return run
+
+
 def test_a_killed_sweep_resumes_to_the_same_bits(tmp_path, monkeypatch):
     grid = {"driver.sigma_theta": [1e-7, 3e-7, 1e-6]}
     base = with_values(BASE, seed=None)  # the seed drawn at the start must be the one resumed with
     real_run = runner.run
-    calls: list[int] = []
-
-    def killed_at_point_2(cfg, *args, **kwargs):
-        calls.append(1)
-        if len(calls) == 3:
-            raise KeyboardInterrupt
-        return real_run(cfg, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", killed_at_point_2)
+    monkeypatch.setattr(runner, "run", _killed_at_point(2))
     with pytest.raises(RunInterrupted, match=r"2 of 3 sweep points are done.*--resume"):
         sweep(base, grid, out=tmp_path, **ONE)
     reruns: list[dict] = []
@@ -370,19 +377,10 @@ def test_a_finished_point_computed_from_an_input_file_since_changed_is_refused(t
     data.write_text(open(example_file("mu_s_example.txt")).read())
     base = with_values(BASE, **{"friction.static": {"name": "empirical", "path": str(data)}})
     grid = {"driver.sigma_theta": [1e-7, 1e-6]}
-    real_run = runner.run
-    calls: list[int] = []
-
-    def killed_at_point_1(cfg, *args, **kwargs):
-        calls.append(1)
-        if len(calls) == 2:
-            raise KeyboardInterrupt
-        return real_run(cfg, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", killed_at_point_1)
-    with pytest.raises(RunInterrupted, match="1 of 2 sweep points are done"):
-        sweep(base, grid, out=tmp_path / "out", **ONE)
-    monkeypatch.setattr(runner, "run", real_run)
+    with monkeypatch.context() as patched:
+        patched.setattr(runner, "run", _killed_at_point(1))
+        with pytest.raises(RunInterrupted, match="1 of 2 sweep points are done"):
+            sweep(base, grid, out=tmp_path / "out", **ONE)
     data.write_text(data.read_text() + "0.7\n")
     with pytest.raises(CheckpointError, match=r"points/0/result\.nc' was computed from other contents of the "
                                               rf"input files than they hold now: '{re.escape(str(data))}'"):
