@@ -34,6 +34,7 @@ import functools
 import json
 import math
 import multiprocessing
+import multiprocessing.connection
 import os
 import signal
 import sys
@@ -453,9 +454,39 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
             pool.shutdown(wait=not forced, cancel_futures=True)
 
 
+# Seconds to wait for the exit status of a worker known to have died (a hang guard: it comes at once).
+_STATUS_WAIT = 5.0
+
+
+def _exit_codes(pool: ProcessPoolExecutor) -> list[int]:
+    """The exit statuses of the workers of ``pool`` that have ended (negative: the signal that ended it).
+
+    The pool's own thread collects a dead worker's status (``waitpid``) at the
+    moment the pool breaks: when it takes it between our look and its own
+    bookkeeping, ``exitcode`` reads None for an instant although the worker
+    is gone. A worker whose end the OS has signalled (its sentinel is ready)
+    is therefore waited for until its status is known.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    try:
+        ended = set(multiprocessing.connection.wait([p.sentinel for p in processes], timeout=0))
+    except (ValueError, OSError):  # a process already closed by the pool
+        return [p.exitcode for p in processes if p.exitcode is not None]
+    deadline = time.monotonic() + _STATUS_WAIT
+    codes = []
+    for p in processes:
+        if p.sentinel not in ended:
+            continue
+        while p.exitcode is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if p.exitcode is not None:
+            codes.append(p.exitcode)
+    return codes
+
+
 def _lost_message(pool: ProcessPoolExecutor) -> str:
-    """One line: a worker of ``pool`` died, and how, where its exit status is still known."""
-    codes = [p.exitcode for p in list((getattr(pool, "_processes", None) or {}).values())]
+    """One line: a worker of ``pool`` died, and how, where its exit status is known."""
+    codes = _exit_codes(pool)
     signals = sorted({-c for c in codes if c is not None and c < 0})
     how = "died abruptly" if not signals else "was killed by " + ", ".join(signal.Signals(s).name for s in signals)
     if signal.SIGKILL in signals:
