@@ -24,7 +24,14 @@ import pytest
 
 import slidernet
 from slidernet.cli import main
-from slidernet.errors import CheckpointError, CheckpointWarning, FolderInUseError, OutputError, PluginError
+from slidernet.errors import (
+    CheckpointError,
+    CheckpointWarning,
+    FolderInUseError,
+    OutputError,
+    PluginError,
+    WorkerLostError,
+)
 
 SMALL = """\
 seed = 1
@@ -580,3 +587,24 @@ def test_a_file_size_limit_is_one_line_naming_the_file_and_the_run_resumes(tmp_p
     assert main(["run", str(config), "--out", str(out), "--resume", "--no-progress"]) == 0
     _assert_same_bits(slidernet.io.read_result(out / "result.nc"), chain8_reference)
     assert _tree(out) == ["result.nc"]
+
+
+def test_a_lost_worker_leaves_no_temporary_file(tmp_path, monkeypatch, chain8_reference):
+    # tests/test_interrupts.py now and then: when a worker died, the other was killed while it wrote a
+    # partial file, and its temporary file stayed in the folder until the resume.
+    from slidernet.ensemble import runner
+
+    out = tmp_path / "out"
+    _stopped_after(CHAIN8, out, 3)  # finished realizations saved: the folder stays resumable
+
+    def lost(cfg, config_json, store, *args, **kwargs):
+        (store.dir / ".partial-000000003.npz.2ja72z68.tmp").write_bytes(b"PK\x03\x04")  # a killed write
+        raise WorkerLostError("A worker process was killed by SIGKILL during the run.")
+
+    monkeypatch.setattr(runner, "_execute", lost)
+    with pytest.raises(WorkerLostError, match=r"killed by SIGKILL during the run\. 3 of 8 realizations are "
+                                              r"finished in .*--resume"):
+        slidernet.run(CHAIN8, out=out, resume=True)
+    assert not [name for name in _tree(out) if name.endswith(".tmp")]
+    monkeypatch.undo()
+    _assert_same_bits(slidernet.run(CHAIN8, out=out, resume=True), chain8_reference)

@@ -375,16 +375,22 @@ def _die_with_parent(parent: int) -> None:
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
-    """Kill the pool's workers now (a second Ctrl-C): their last saves are complete files.
+    """Kill the pool's workers now (a second Ctrl-C, a worker lost) and wait until they have ended.
 
     SIGKILL, since the workers ignore SIGTERM (see :func:`_init_worker`).
+    Their last saves are complete files; a save they were writing is left
+    under a temporary name, which the caller may remove once this returns:
+    no worker writes any more.
     """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
     kill = getattr(pool, "kill_workers", None)  # Python >= 3.14
     if kill is not None:
         kill()
-        return
-    for proc in list((getattr(pool, "_processes", None) or {}).values()):
-        proc.kill()
+    else:
+        for proc in processes:
+            proc.kill()
+    for proc in processes:
+        proc.join()  # at once: SIGKILL cannot be caught
 
 
 def _local_pool(indices: Sequence[int], args: Task, workers: int,

@@ -221,6 +221,10 @@ def run(
                 store.flush()  # the realizations that did finish are kept
             except OutputError:
                 pass  # the disk refuses: the error that stopped the run says why
+        if isinstance(exc, WorkerLostError):
+            # The other workers were killed, and have ended: a save one of them was writing is only a
+            # temporary file now, which would stay in the folder until the resume.
+            store.remove_temporaries()
         store.abandon()  # a run that failed before saving anything leaves the folder as it found it
         if isinstance(exc, (WorkerLostError, OutputError)) and store.dir.exists():
             raise type(exc)(f"{exc} {_saved_work(store, R)}") from None

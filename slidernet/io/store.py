@@ -325,8 +325,7 @@ class RunStore:
         """:meth:`open` under the lock; ``existed``: the checkpoint folder was there before."""
         out = self.dir.parent
         # Under the lock no other process writes here: a temporary file is what a killed one left.
-        remove_temporaries(out)
-        remove_temporaries(self.dir)
+        self.remove_temporaries()
         run_json = self.dir / "run.json"
         result = out / "result.nc"
         if self.overwrite and not self.resume:
@@ -452,6 +451,14 @@ class RunStore:
         for path in reversed(self._created):
             shutil.rmtree(path, ignore_errors=True)
         self._created.clear()
+
+    def remove_temporaries(self) -> None:
+        """Remove the temporary files of writes that were killed, in the output and checkpoint folders.
+
+        Call this only while the lock is held and no worker of this run writes.
+        """
+        remove_temporaries(self.dir.parent)
+        remove_temporaries(self.dir)
 
     def close(self) -> None:
         """Let the folder's lock go (however the run ended; :meth:`open` took it)."""
