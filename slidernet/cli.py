@@ -22,11 +22,17 @@ import argparse
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from slidernet.errors import RunInterrupted, SlidAwayWarning, SlidernetError, UnknownPluginError
+from slidernet.errors import (
+    CheckpointWarning,
+    RunInterrupted,
+    SlidAwayWarning,
+    SlidernetError,
+    UnknownPluginError,
+)
 
 if TYPE_CHECKING:
     from slidernet.plugins.registry import Registry
@@ -313,6 +319,19 @@ def _cmd_units(args: argparse.Namespace) -> int:
     return 0
 
 
+def _one_line_warnings(show: Callable[..., None]) -> Callable[..., None]:
+    """``warnings.showwarning`` that shows a :class:`~slidernet.errors.CheckpointWarning` as one line on
+    stderr, and any other warning as ``show`` does."""
+
+    def showwarning(message, category, filename, lineno, file=None, line=None) -> None:
+        if issubclass(category, CheckpointWarning):
+            print(f"slidernet: warning: {message}", file=sys.stderr if file is None else file, flush=True)
+        else:
+            show(message, category, filename, lineno, file, line)
+
+    return showwarning
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``slidernet`` command; returns the exit status."""
     args = _parser().parse_args(argv)
@@ -320,7 +339,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "plugins": _cmd_plugins,
                 "units": _cmd_units}
     try:
-        status = commands[args.command](args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warnings(warnings.showwarning)
+            status = commands[args.command](args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit
         return status
     except SlidernetError as exc:

@@ -56,6 +56,15 @@ class OutputError(SlidernetError, OSError):
     or it holds a finished result that would be replaced without ``overwrite``."""
 
 
+class FolderInUseError(OutputError):
+    """An output folder is locked by a run that is still going (another process holds its lock)."""
+
+
+class WorkerLostError(SlidernetError, RuntimeError):
+    """A local worker process died abruptly (killed by a signal, e.g. by the out-of-memory killer) during a
+    run; the work saved until then is kept, and the run can be resumed."""
+
+
 class SchedulerError(SlidernetError, ConnectionError):
     """The Dask scheduler could not be reached within ``execution.scheduler_timeout``."""
 
@@ -75,6 +84,10 @@ class RunInterrupted(KeyboardInterrupt):
     def __init__(self, message: str = "", signum: int = 2) -> None:
         super().__init__(message)
         self.signum = int(signum)
+
+
+class CheckpointWarning(UserWarning):
+    """Something of a checkpoint folder was found damaged and is recomputed, or a folder cannot be locked."""
 
 
 class SlidAwayWarning(UserWarning):

@@ -8,6 +8,12 @@ memory, and after any number of kills and resumes.
 from __future__ import annotations
 
 import json
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import types
 
 import netCDF4
 import numpy as np
@@ -15,6 +21,7 @@ import pytest
 import xarray as xr
 
 import slidernet
+from slidernet.ensemble.execution import _lost_message
 from slidernet.errors import CheckpointError, ConfigError
 from slidernet.io import read_result, write_netcdf
 
@@ -197,3 +204,21 @@ def test_a_stop_is_seen_inside_a_long_thermal_step(tmp_path):
     for key in ("n", "x_G", "mu_max"):
         np.testing.assert_array_equal(resumed[key], expected[key], strict=True)
     assert resumed["n"][-1] > 3 * scene.batch
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks a process")
+def test_a_killed_worker_is_named_by_its_signal_while_the_pool_collects_its_status():
+    # benchmarks/fault_injection.py: a killed worker was now and then said to have "died abruptly": the
+    # pool's thread had taken its exit status (waitpid) and not yet recorded it when the message was made.
+    worker = multiprocessing.get_context("fork").Process(target=signal.pause)
+    worker.start()
+    os.kill(worker.pid, signal.SIGKILL)
+    os.waitpid(worker.pid, 0)  # the pool's thread takes the status first ...
+    record = threading.Timer(0.05, setattr, (worker._popen, "returncode", -signal.SIGKILL))
+    record.start()  # ... and records it an instant later
+    try:
+        message = _lost_message(types.SimpleNamespace(_processes={worker.pid: worker}))
+    finally:
+        record.join()
+    assert message.startswith("A worker process was killed by SIGKILL (by a user, a batch scheduler or the "
+                              "out-of-memory killer) during the run")

@@ -82,6 +82,15 @@ def _wait_at_gate(gate: Path, proc: subprocess.Popen, processes: int) -> None:
         time.sleep(0.02)
 
 
+def _run_at_gate(config: Path, tmp_path: Path, workers: int) -> tuple[Path, Path, subprocess.Popen]:
+    """Start ``slidernet run config`` in ``tmp_path/out`` with ``workers`` workers, and wait until each
+    worker stands at the gate of ``tmp_path/gate``; the output folder, the gate and the process."""
+    out, gate = tmp_path / "out", tmp_path / "gate"
+    proc = _cli("run", str(config), "--out", str(out), "--workers", str(workers), gate=gate)
+    _wait_at_gate(gate, proc, workers)
+    return out, gate, proc
+
+
 def _assert_same_bits(a_path: Path, b_path: Path) -> None:
     a, b = read_result(a_path), read_result(b_path)
     assert set(a.variables) == set(b.variables)
@@ -126,9 +135,7 @@ def _resume(config: Path, out: Path, workers: str = "2") -> None:
 @pytest.mark.parametrize("workers", [1, 2], ids=["one-worker", "two-workers"])
 def test_a_signal_saves_the_running_realizations_and_starts_no_other(tmp_path, config, reference, sig, status,
                                                                       workers):
-    out, gate = tmp_path / "out", tmp_path / "gate"
-    proc = _cli("run", str(config), "--out", str(out), "--workers", str(workers), gate=gate)
-    _wait_at_gate(gate, proc, workers)
+    out, gate, proc = _run_at_gate(config, tmp_path, workers)
     if sig == signal.SIGINT:
         os.killpg(proc.pid, sig)  # Ctrl-C reaches every process of the terminal's group
     else:
@@ -156,9 +163,7 @@ def test_a_signal_saves_the_running_realizations_and_starts_no_other(tmp_path, c
 
 @pytest.mark.slow
 def test_a_second_ctrl_c_stops_at_once_and_leaves_a_consistent_folder(tmp_path, config, reference):
-    out, gate = tmp_path / "out", tmp_path / "gate"
-    proc = _cli("run", str(config), "--out", str(out), "--workers", "2", gate=gate)
-    _wait_at_gate(gate, proc, 2)
+    out, _, proc = _run_at_gate(config, tmp_path, 2)
     os.killpg(proc.pid, signal.SIGINT)
     # Two signals sent at once would merge into one: wait until the first is taken, which slidernet says.
     first = proc.stderr.readline()
@@ -175,9 +180,7 @@ def test_a_second_ctrl_c_stops_at_once_and_leaves_a_consistent_folder(tmp_path, 
 @pytest.mark.slow
 @pytest.mark.parametrize("workers", [1, 2], ids=["one-worker", "two-workers"])
 def test_resume_after_kill_9_gives_the_same_bits(tmp_path, config, reference, workers):
-    out, gate = tmp_path / "out", tmp_path / "gate"
-    proc = _cli("run", str(config), "--out", str(out), "--workers", str(workers), gate=gate)
-    _wait_at_gate(gate, proc, workers)
+    out, _, proc = _run_at_gate(config, tmp_path, workers)
     assert len(list((out / "checkpoint").glob("partial-*.npz"))) == workers
     os.killpg(proc.pid, signal.SIGKILL)  # the whole session, as in a machine failure
     proc.wait()
@@ -262,9 +265,7 @@ def test_sigterm_stops_a_realization_inside_a_long_thermal_step(tmp_path):
     config.write_text(LONG_STEP)
     rc, err = _finish(_cli("run", str(config), "--out", str(tmp_path / "reference"), "--workers", "1"))
     assert rc == 0, err
-    out, gate = tmp_path / "out", tmp_path / "gate"
-    proc = _cli("run", str(config), "--out", str(out), "--workers", "1", gate=gate)
-    _wait_at_gate(gate, proc, 1)
+    out, gate, proc = _run_at_gate(config, tmp_path, 1)
     os.kill(proc.pid, signal.SIGTERM)
     assert "SIGTERM received" in proc.stderr.readline()  # the stop is requested before the gate opens
     (gate / "open").touch()
@@ -278,3 +279,79 @@ def test_sigterm_stops_a_realization_inside_a_long_thermal_step(tmp_path):
         assert header["step"] == 0 and header["n"] == 65_536
     _resume(config, out)
     _assert_same_bits(out / "result.nc", tmp_path / "reference" / "result.nc")
+
+
+def _gone(pid: int) -> bool:
+    """True once process ``pid`` has ended (a zombie not yet reaped by its new parent has ended too)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+    return state in ("Z", "X")
+
+
+def _workers_at(gate: Path) -> list[int]:
+    return sorted({int(p.name.split("-")[1]) for p in gate.glob("waiting-*")})
+
+
+def _wait_until_gone(pids: list[int]) -> list[int]:
+    """The processes of ``pids`` still there after a hang guard of 60 s (death by a signal is immediate)."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not all(_gone(p) for p in pids):
+        time.sleep(0.02)
+    return [p for p in pids if not _gone(p)]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_workers_die_with_their_parent(tmp_path, config, reference):
+    # kill -9 of the parent of a 2-worker run left both workers waiting forever (about 220 MB each).
+    out, gate, proc = _run_at_gate(config, tmp_path, 2)
+    workers = _workers_at(gate)
+    assert len(workers) == 2 and proc.pid not in workers
+    os.kill(proc.pid, signal.SIGKILL)  # the parent alone
+    proc.wait()
+    left = _wait_until_gone(workers)
+    for pid in left:  # do not leave them behind when the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f"workers {left} outlived their parent"
+    _assert_consistent(out / "checkpoint")
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+    assert sorted(p.name for p in out.iterdir()) == ["result.nc"]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_killed_worker_is_one_line_and_the_run_resumes(tmp_path, config, reference):
+    # kill -9 of one worker gave a BrokenProcessPool traceback and exit 1.
+    out, gate, proc = _run_at_gate(config, tmp_path, 2)
+    killed, other = _workers_at(gate)
+    os.kill(killed, signal.SIGKILL)
+    (gate / "open").touch()
+    rc, err = _finish(proc)
+    assert rc == 2 and "Traceback" not in err and err.count("\n") == 1, err
+    assert "A worker process was killed by SIGKILL" in err and "0 of 4 realizations are finished and 2 saved " \
+        "in progress" in err and "--resume" in err
+    assert not _wait_until_gone([other]), "the other worker outlived the run"
+    _assert_consistent(out / "checkpoint")
+    _resume(config, out)
+    _assert_same_bits(out / "result.nc", reference)
+
+
+@pytest.mark.slow
+def test_a_second_run_in_the_folder_of_a_run_still_going_is_refused(tmp_path, config, reference):
+    # --resume of a run still going was accepted: every realization was computed twice and the first
+    # run then failed. Without --resume the second run said "holds an interrupted run".
+    out, gate, proc = _run_at_gate(config, tmp_path, 1)
+    try:
+        for flags in (["--resume"], [], ["--overwrite"]):
+            rc, err = _finish(_cli("run", str(config), "--out", str(out), *flags))
+            assert rc == 2 and err.count("\n") == 1, err
+            assert f"a slidernet run is still going there (process {proc.pid} holds its lock" in err
+    finally:
+        (gate / "open").touch()  # the first run goes on to its end, whatever happened
+    rc, err = _finish(proc)
+    assert rc == 0, err
+    _assert_same_bits(out / "result.nc", reference)
+    assert sorted(p.name for p in out.iterdir()) == ["result.nc"]

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import json
 
+import netCDF4
+import numpy as np
 import pytest
 import xarray as xr
 
 import slidernet
+from slidernet.errors import ResultError
 from slidernet.io import read_result, result_config, write_netcdf
+from slidernet.io.netcdf import SCALAR_CRC
 from tests.conftest import make_config
 
 
@@ -88,3 +92,43 @@ def test_failed_write_keeps_the_previous_result(result, tmp_path, monkeypatch):
         write_netcdf(result, path)
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["result.nc"]
+
+
+def _checksummed(path) -> dict[str, bool]:
+    """Per variable: whether the file holds a checksum of its data (fletcher32 chunks, or a scalar's crc32)."""
+    with netCDF4.Dataset(path) as nc:
+        return {name: bool(var.filters()["fletcher32"]) if var.dimensions else SCALAR_CRC in var.ncattrs()
+                for name, var in nc.variables.items()}
+
+
+@pytest.mark.parametrize("writer", ["write_netcdf", "streamed"])
+def test_every_variable_of_a_result_file_carries_a_checksum(result, tmp_path, writer):
+    if writer == "write_netcdf":
+        path = write_netcdf(result, tmp_path / "result.nc")
+    else:
+        cfg = make_config(steps=50, realizations=3, observables=["n", "mu_max", "x_G", "mu_eff", "n_records"])
+        slidernet.run(cfg, out=tmp_path, workers=1).close()
+        path = tmp_path / "result.nc"
+    checked = _checksummed(path)
+    assert set(checked) == set(result.variables) and all(checked.values()), checked
+    assert {"r_mean", "r_sem"} <= {name for name, var in result.variables.items() if not var.dims}
+
+
+@pytest.mark.parametrize("name", ["n", "mu_max_mean", "r_mean"], ids=["per-realization", "mean", "scalar"])
+def test_a_flipped_bit_in_a_result_file_is_an_error_naming_the_variable(result, tmp_path, name):
+    # result.nc carried no checksum: a flipped bit in its data read (and plotted) silently.
+    path = write_netcdf(result, tmp_path / "result.nc")
+    raw = np.ascontiguousarray(result[name].values, dtype=result[name].dtype.newbyteorder("<")).tobytes()
+    data = bytearray(path.read_bytes())
+    assert data.count(raw) == 1
+    data[data.find(raw) + len(raw) // 2] ^= 0x04
+    path.write_bytes(bytes(data))
+    with pytest.raises(ResultError, match=rf"result file '{path}' is damaged: the (data|value) of '{name}'"):
+        read_result(path)
+
+
+def test_a_truncated_result_file_is_an_error_naming_it(result, tmp_path):
+    path = write_netcdf(result, tmp_path / "result.nc")
+    path.write_bytes(path.read_bytes()[:5000])
+    with pytest.raises(ResultError, match=rf"result file '{path}' cannot be read: .*truncated or damaged"):
+        read_result(path)

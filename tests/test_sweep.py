@@ -6,6 +6,7 @@ import copy
 import importlib
 import json
 import re
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -273,19 +274,25 @@ def test_out_folder_holds_every_point_and_the_result(tmp_path):
     assert replaced["sigma_theta"].values.tolist() == [2e-7, 1e-6]
 
 
+def _killed_at_point(k: int) -> Callable[..., xr.Dataset]:
+    """``runner.run`` that raises KeyboardInterrupt, as Ctrl-C would, when point ``k`` (from 0) starts."""
+    real_run = runner.run
+    calls: list[int] = []
+
+    def run(cfg, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == k + 1:
+            raise KeyboardInterrupt
+        return real_run(cfg, *args, **kwargs)
+
+    return run
+
+
 def test_a_killed_sweep_resumes_to_the_same_bits(tmp_path, monkeypatch):
     grid = {"driver.sigma_theta": [1e-7, 3e-7, 1e-6]}
     base = with_values(BASE, seed=None)  # the seed drawn at the start must be the one resumed with
     real_run = runner.run
-    calls: list[int] = []
-
-    def killed_at_point_2(cfg, *args, **kwargs):
-        calls.append(1)
-        if len(calls) == 3:
-            raise KeyboardInterrupt
-        return real_run(cfg, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", killed_at_point_2)
+    monkeypatch.setattr(runner, "run", _killed_at_point(2))
     with pytest.raises(RunInterrupted, match=r"2 of 3 sweep points are done.*--resume"):
         sweep(base, grid, out=tmp_path, **ONE)
     reruns: list[dict] = []
@@ -333,3 +340,48 @@ def test_cli_sweep_writes_one_dataset_with_the_swept_dims(tmp_path, capsys):
     assert ds["n"].dims == ("sigma_theta", "mu_d", "realization", "t")
     assert main([*argv[:3], "driver.sigma_theta=1e-7", "--set", "driver.sigma_theta=2", *argv[6:]]) == 2
     assert "given twice" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text", ["[]", "{}"], ids=["list", "empty-object"])
+def test_a_damaged_sweep_json_is_one_line(tmp_path, text):
+    # sweep.json holding [] gave an AttributeError traceback.
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    sweep(BASE, grid, out=tmp_path, **ONE)
+    (tmp_path / "sweep.json").write_text(text)
+    with pytest.raises(CheckpointError, match=r"sweep\.json' does not identify a sweep .*--overwrite"):
+        sweep(BASE, grid, out=tmp_path, resume=True, **ONE)
+
+
+def test_a_sweep_still_going_is_not_touched(tmp_path):
+    # A second sweep in the folder of one still going (even with --overwrite) is refused before it
+    # removes or writes anything.
+    from slidernet.errors import FolderInUseError
+    from slidernet.io.store import FolderLock
+
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    sweep(BASE, grid, out=tmp_path, **ONE)
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    with FolderLock(tmp_path):  # held as the sweep still going holds it
+        for flags in ({"overwrite": True}, {"resume": True}):
+            with pytest.raises(FolderInUseError, match="a slidernet run is still going there"):
+                sweep(BASE, grid, out=tmp_path, **flags, **ONE)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before
+
+
+def test_a_finished_point_computed_from_an_input_file_since_changed_is_refused(tmp_path, monkeypatch):
+    # The finished points of a killed sweep are read back on resume: one computed from a data file that
+    # has changed since would be stacked beside points computed from the new contents.
+    from slidernet.plugins.contract import example_file
+
+    data = tmp_path / "mu_s.txt"
+    data.write_text(open(example_file("mu_s_example.txt")).read())
+    base = with_values(BASE, **{"friction.static": {"name": "empirical", "path": str(data)}})
+    grid = {"driver.sigma_theta": [1e-7, 1e-6]}
+    with monkeypatch.context() as patched:
+        patched.setattr(runner, "run", _killed_at_point(1))
+        with pytest.raises(RunInterrupted, match="1 of 2 sweep points are done"):
+            sweep(base, grid, out=tmp_path / "out", **ONE)
+    data.write_text(data.read_text() + "0.7\n")
+    with pytest.raises(CheckpointError, match=r"points/0/result\.nc' was computed from other contents of the "
+                                              rf"input files than they hold now: '{re.escape(str(data))}'"):
+        sweep(base, grid, out=tmp_path / "out", resume=True, **ONE)

@@ -21,8 +21,9 @@ from pydantic import ValidationError
 
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
+from slidernet.model.builders import graph_files
 from slidernet.model.network import Network
-from slidernet.plugins.loader import absolute_entry, import_plugins
+from slidernet.plugins.loader import absolute_entry, import_plugins, is_file_entry
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -73,17 +74,59 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
-    friction = source.get("friction")
-    static = friction.get("static") if isinstance(friction, dict) else None
-    for table in (source.get("network"), source.get("driver"), static):
-        if isinstance(table, dict) and isinstance(table.get("path"), str):
-            named = Path(table["path"])
-            if not named.is_absolute():
-                table["path"] = str(path.parent / named)
+    for table in _path_tables(source).values():
+        named = Path(table["path"])
+        if not named.is_absolute():
+            table["path"] = str(path.parent / named)
     plugins = source.get("plugins")
     if isinstance(plugins, list):  # anything else is refused, by name, when it is validated
         source["plugins"] = [absolute_entry(e, path.parent) if isinstance(e, str) else e for e in plugins]
     return source
+
+
+def _path_tables(source: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """The tables of a raw or dumped configuration that name a file under ``path``, by their dotted name.
+
+    The one list of the places a configuration names a data file: a graph
+    (``network``), a temperature series (``driver``), measured thresholds
+    (``friction.static``).
+    """
+    friction = source.get("friction")
+    tables = {"network": source.get("network"), "driver": source.get("driver"),
+              "friction.static": friction.get("static") if isinstance(friction, Mapping) else None}
+    return {name: table for name, table in tables.items()
+            if isinstance(table, dict) and isinstance(table.get("path"), str)}
+
+
+def input_files(cfg: Config) -> dict[str, str]:
+    """Every file a run of ``cfg`` reads, by what names it: its data files and plugin files.
+
+    Parameters
+    ----------
+    cfg : Config
+        A validated configuration.
+
+    Returns
+    -------
+    dict of str to str
+        ``"network.path"``, ``"driver.path"``, ``"friction.static.path"``
+        (where given), ``"network.path (node file)"`` (the companion node
+        file of an edge list) and ``"plugins[i]"`` for each entry of
+        ``plugins`` that is a ``.py`` file, to the path as the configuration
+        holds it (a relative one is relative to the current directory, where
+        it is read). A plugin given as a module name is not a file of the
+        configuration and is not listed.
+    """
+    dumped = cfg.model_dump(mode="json")
+    files = {f"{name}.path": table["path"] for name, table in _path_tables(dumped).items()}
+    if cfg.network.kind == "graph" and cfg.network.path is not None:
+        nodes = graph_files(cfg.network.path).get("nodes")
+        if nodes is not None:
+            files["network.path (node file)"] = str(nodes)
+    for i, entry in enumerate(cfg.plugins or ()):
+        if is_file_entry(entry):
+            files[f"plugins[{i}]"] = entry
+    return files
 
 
 def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:

@@ -17,6 +17,10 @@ Backends
 - ``workers = N``: a :class:`concurrent.futures.ProcessPoolExecutor` of N
   processes, forked where the platform can (the workers then inherit the
   compiled kernels and plugins registered at run time), spawned elsewhere.
+  A worker dies with its parent (:func:`_die_with_parent`): a parent killed
+  by kill -9 leaves no worker behind. A worker that dies stops the run with
+  :class:`~slidernet.errors.WorkerLostError`; the other workers are ended
+  at once, and what was saved stays resumable.
 - ``scheduler = "tcp://host:port"``: a :class:`distributed.Client` on that
   scheduler. The workers need slidernet (and any plugin) installed, and the
   files named in the config (and the output directory, for checkpoints inside
@@ -25,10 +29,12 @@ Backends
 
 from __future__ import annotations
 
+import ctypes
 import functools
 import json
 import math
 import multiprocessing
+import multiprocessing.connection
 import os
 import signal
 import sys
@@ -38,12 +44,13 @@ import uuid
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from slidernet.errors import SchedulerError
+from slidernet.errors import SchedulerError, WorkerLostError
 
 Record = dict[str, Any]
 
@@ -315,8 +322,9 @@ def _window(workers: int) -> int:
 _POLL = 0.1
 
 
-def _init_worker(flag: Any) -> None:
-    """Initializer of a pool worker: the parent's flag is its stop flag; signals are the parent's."""
+def _init_worker(flag: Any, parent: int) -> None:
+    """Initializer of a pool worker: the parent's flag is its stop flag; signals are the parent's; it dies
+    with its parent (process id ``parent``)."""
     global _WORKER_STOP
     _WORKER_STOP = flag
     # Ctrl-C reaches every process of the terminal's group, and a batch
@@ -325,19 +333,64 @@ def _init_worker(flag: Any) -> None:
     # clean point and saves; a worker killed by the signal would lose its work.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    _die_with_parent(parent)
+
+
+# Linux's prctl option that sends this process a signal when its parent dies (<linux/prctl.h>).
+_PR_SET_PDEATHSIG = 1
+# Seconds between two looks at the parent process, where the OS cannot send a signal on its death.
+_PARENT_POLL = 1.0
+
+
+def _die_with_parent(parent: int) -> None:
+    """End this worker process when its parent process ends, however the parent ends (kill -9 included).
+
+    A pool worker waits for its next task on a pipe whose writing end it
+    inherited itself, so it never sees the parent go: without this, a parent
+    killed by kill -9 left its workers waiting forever (about 220 MB each).
+    On Linux the kernel sends SIGKILL to the worker when its parent dies
+    (``prctl(PR_SET_PDEATHSIG)``, through ctypes): at once, even while the
+    worker runs a compiled kernel that holds the GIL. Elsewhere a daemon
+    thread looks at ``os.getppid()`` every :data:`_PARENT_POLL` s and ends
+    the process when the parent has changed. Either way the worker's files
+    are consistent: every file is written atomically.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        except (OSError, AttributeError):
+            armed = False
+        if armed:
+            if os.getppid() != parent:  # the parent died before the signal was armed
+                os._exit(1)
+            return
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(_PARENT_POLL)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="slidernet-parent-watch", daemon=True).start()
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
-    """Kill the pool's workers now (a second Ctrl-C): their last saves are complete files.
+    """Kill the pool's workers now (a second Ctrl-C, a worker lost) and wait until they have ended.
 
     SIGKILL, since the workers ignore SIGTERM (see :func:`_init_worker`).
+    Their last saves are complete files; a save they were writing is left
+    under a temporary name, which the caller may remove once this returns:
+    no worker writes any more.
     """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
     kill = getattr(pool, "kill_workers", None)  # Python >= 3.14
     if kill is not None:
         kill()
-        return
-    for proc in list((getattr(pool, "_processes", None) or {}).values()):
-        proc.kill()
+    else:
+        for proc in processes:
+            proc.kill()
+    for proc in processes:
+        proc.join()  # at once: SIGKILL cannot be caught
 
 
 def _local_pool(indices: Sequence[int], args: Task, workers: int,
@@ -345,7 +398,8 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
     method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
     ctx = multiprocessing.get_context(method)
     flag = ctx.Event()
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker, initargs=(flag,))
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                               initargs=(flag, os.getpid()))
     todo = iter(indices)
     running: dict[Future, int] = {}
 
@@ -370,12 +424,19 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
                 r = running.pop(fut)
                 if fut.cancelled():
                     continue
-                record = _reraise(fut.result())
+                try:
+                    result = fut.result()
+                except BrokenProcessPool:
+                    running.clear()
+                    raise WorkerLostError(_lost_message(pool)) from None
+                record = _reraise(result)
                 if record is not None:
                     yield r, record
                 if not stop.requested:
                     submit_next()
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, WorkerLostError):
+        # A second Ctrl-C; or a worker died, and the pool can no longer send a task or a stop to the
+        # others (they ignore SIGTERM): end them now. Their last saves are complete files.
         forced = True
         raise
     finally:
@@ -397,6 +458,46 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
             if forced:
                 _terminate(pool)
             pool.shutdown(wait=not forced, cancel_futures=True)
+
+
+# Seconds to wait for the exit status of a worker known to have died (a hang guard: it comes at once).
+_STATUS_WAIT = 5.0
+
+
+def _exit_codes(pool: ProcessPoolExecutor) -> list[int]:
+    """The exit statuses of the workers of ``pool`` that have ended (negative: the signal that ended it).
+
+    The pool's own thread collects a dead worker's status (``waitpid``) at the
+    moment the pool breaks: when it takes it between our look and its own
+    bookkeeping, ``exitcode`` reads None for an instant although the worker
+    is gone. A worker whose end the OS has signalled (its sentinel is ready)
+    is therefore waited for until its status is known.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    try:
+        ended = set(multiprocessing.connection.wait([p.sentinel for p in processes], timeout=0))
+    except (ValueError, OSError):  # a process already closed by the pool
+        return [p.exitcode for p in processes if p.exitcode is not None]
+    deadline = time.monotonic() + _STATUS_WAIT
+    codes = []
+    for p in processes:
+        if p.sentinel not in ended:
+            continue
+        while p.exitcode is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if p.exitcode is not None:
+            codes.append(p.exitcode)
+    return codes
+
+
+def _lost_message(pool: ProcessPoolExecutor) -> str:
+    """One line: a worker of ``pool`` died, and how, where its exit status is known."""
+    codes = _exit_codes(pool)
+    signals = sorted({-c for c in codes if c is not None and c < 0})
+    how = "died abruptly" if not signals else "was killed by " + ", ".join(signal.Signals(s).name for s in signals)
+    if signal.SIGKILL in signals:
+        how += " (by a user, a batch scheduler or the out-of-memory killer)"
+    return f"A worker process {how} during the run; the other workers were stopped."
 
 
 def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,

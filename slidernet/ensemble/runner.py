@@ -17,11 +17,20 @@ from tqdm.auto import tqdm
 from slidernet._version import __version__
 from slidernet.analysis.observables import CHUNK, assemble
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
+from slidernet.config.loading import input_files
 from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
 from slidernet.ensemble.stream import write_result_stream
-from slidernet.errors import CheckpointError, RunInterrupted, SlidAwayWarning, param_error
+from slidernet.errors import (
+    CheckpointError,
+    OutputError,
+    RunInterrupted,
+    SlidAwayWarning,
+    WorkerLostError,
+    param_error,
+)
 from slidernet.io import read_result
-from slidernet.io.store import RunStore
+from slidernet.io.netcdf import open_result
+from slidernet.io.store import RunStore, changed_inputs, file_digest
 from slidernet.solver.compile import compile_kernels, terminal_notice
 
 
@@ -37,11 +46,21 @@ def realization_seeds(seed: int, realizations: int) -> list[np.random.SeedSequen
     return np.random.SeedSequence(seed).spawn(realizations)
 
 
+def input_digests(cfg: Config) -> dict[str, dict[str, str]]:
+    """Every file a run of ``cfg`` reads (``config.loading.input_files``): its ``path`` and ``sha256``."""
+    return {what: {"path": path, "sha256": file_digest(path)} for what, path in input_files(cfg).items()}
+
+
 def identity(requested: Config, resolved: Config) -> dict[str, Any]:
-    """What a checkpoint must match to be resumed: the config without its execution table, the seed, R."""
+    """What a checkpoint must match to be resumed (``io.store.IDENTITY_KEYS``).
+
+    The configuration without its execution table, the seed, the number of
+    realizations, the slidernet version and the SHA-256 of every input file
+    (a graph, a temperature series, measured thresholds, plugin files).
+    """
     config = requested.model_dump(mode="json", exclude={"execution"})
     return {"config": config, "seed": resolved.seed, "realizations": resolved.realizations,
-            "slidernet_version": __version__}
+            "slidernet_version": __version__, "inputs": input_digests(requested)}
 
 
 #: What each value of a scene's ``tilt_at`` measures: the ``mu_eff_estimator`` attribute of a result.
@@ -53,9 +72,11 @@ MU_EFF_ESTIMATORS = {
 }
 
 
-def _attrs(cfg: Config, scene: Any, workers: int, scheduler: str | None) -> dict[str, str]:
+def _attrs(cfg: Config, scene: Any, workers: int, scheduler: str | None,
+           inputs: dict[str, dict[str, str]]) -> dict[str, str]:
     attrs = {
         "config": json.dumps(cfg.model_dump(mode="json", exclude={"execution"}), sort_keys=True),
+        "inputs": json.dumps(inputs, sort_keys=True),
         "execution": json.dumps({"workers": workers, "scheduler": scheduler}),
         "slidernet_version": __version__,
         "seed": str(cfg.seed),
@@ -171,31 +192,46 @@ def run(
     R = cfg.realizations
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     scene = scene_of(config_json)  # validates the scene before any file is touched; forked workers inherit it
+    run_identity = identity(requested, cfg)
     store = None
     if out is not None:
-        store = RunStore(out, identity(requested, cfg), resume, overwrite=overwrite)
-        seed = store.open()
+        store = RunStore(out, run_identity, resume, overwrite=overwrite)
+        seed = store.open()  # holds the folder's lock until store.close()
         if seed != cfg.seed:  # a resumed run whose config left the seed to fresh entropy
             cfg = _with_seed(cfg, seed)
             config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     try:
         done = store.done() if store is not None else {}
-        records = _execute(cfg, config_json, requested, store, done, progress, on_realization, workers,
-                           scheduler, timeout)
+        records = _execute(cfg, config_json, store, done, progress, on_realization, workers, scheduler, timeout)
+        attrs = _attrs(cfg, scene, workers, scheduler, run_identity["inputs"])
+        if store is None:
+            ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
+        else:
+            path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
+                                       list(cfg.observables), attrs)
+            store.remove()
+            ds = open_result(path)
     except RunInterrupted:
         raise
-    except BaseException:
-        if store is not None:
-            store.abandon()  # a run that failed before saving anything leaves the folder as it found it
+    except BaseException as exc:
+        if store is None:
+            raise
+        if isinstance(exc, Exception):
+            try:
+                store.flush()  # the realizations that did finish are kept
+            except OutputError:
+                pass  # the disk refuses: the error that stopped the run says why
+        if isinstance(exc, WorkerLostError):
+            # The other workers were killed, and have ended: a save one of them was writing is only a
+            # temporary file now, which would stay in the folder until the resume.
+            store.remove_temporaries()
+        store.abandon()  # a run that failed before saving anything leaves the folder as it found it
+        if isinstance(exc, (WorkerLostError, OutputError)) and store.dir.exists():
+            raise type(exc)(f"{exc} {_saved_work(store, R)}") from None
         raise
-    attrs = _attrs(cfg, scene, workers, scheduler)
-    if store is None:
-        ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
-    else:
-        path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
-                                   list(cfg.observables), attrs)
-        store.remove()
-        ds = xr.open_dataset(path, engine="netcdf4")
+    finally:
+        if store is not None:
+            store.close()
     warn_if_all_slid_away(ds)
     return ds
 
@@ -219,9 +255,9 @@ def warn_if_all_slid_away(ds: xr.Dataset) -> None:
         warnings.warn(line[0].upper() + line[1:] + ".", SlidAwayWarning, stacklevel=3)
 
 
-def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore | None,
-             done: Mapping[int, Any], progress: bool | None, on_realization: Callable[[int], None] | None,
-             workers: int, scheduler: str | None, timeout: float) -> dict[int, dict]:
+def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mapping[int, Any],
+             progress: bool | None, on_realization: Callable[[int], None] | None, workers: int,
+             scheduler: str | None, timeout: float) -> dict[int, dict]:
     """Run the realizations not ``done``; records kept in memory, or in ``store`` (flushed as they come).
 
     Ctrl-C and SIGTERM stop the run at a clean point of every running
@@ -231,7 +267,8 @@ def _execute(cfg: Config, config_json: str, requested: Config, store: RunStore |
     ex = cfg.execution
     R = cfg.realizations
     pending = [r for r in range(R) if r not in done]
-    meta = {"config": json.dumps(identity(requested, cfg), sort_keys=True)}
+    # A partial file names its run: one of another run is never resumed (io.store.RunStore).
+    meta = {} if store is None else {"run": store.digest}
 
     def args(r: int) -> tuple:
         partial = None if store is None else str(store.partial(r))
@@ -278,15 +315,17 @@ def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:
         return RunInterrupted(f"interrupted by {name}; nothing was saved (run with an output directory "
                               "to keep the work of an interrupted run).", signum)
     store.flush()
-    saved = len(store.done())
+    return RunInterrupted(f"interrupted by {name}: {_saved_work(store, R)}", signum)
+
+
+def _saved_work(store: RunStore, R: int) -> str:
+    """What the checkpoint folder holds, and the command that continues the run."""
+    saved = len(store.done(strict=False))
     running = store.partials()
-    return RunInterrupted(
-        f"interrupted by {name}: {saved} of {R} realizations are finished"
-        + (f" and {running} saved in progress" if running else "")
-        + f" in {str(store.dir)!r}; continue with --resume on the same command, "
-        f"e.g. `slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`.",
-        signum,
-    )
+    return (f"{saved} of {R} realizations are finished"
+            + (f" and {running} saved in progress" if running else "")
+            + f" in {str(store.dir)!r}; continue with --resume on the same command, "
+            f"e.g. `slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`.")
 
 
 def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, resume: bool = False,
@@ -327,6 +366,10 @@ def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, 
         if json.loads(ds.attrs["config"]) != expected:
             raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} holds a run of another "
                                   "configuration than this one.")
+        changed = changed_inputs(json.loads(ds.attrs.get("inputs", "{}")), input_digests(cfg))
+        if changed:
+            raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} was computed from other contents of "
+                                  f"the input files than they hold now: {changed}. Start again with --overwrite.")
         for r in range(cfg.realizations):
             if on_realization is not None:
                 on_realization(r)

@@ -113,7 +113,7 @@ from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
 from slidernet.io import atomic_output, write_netcdf
-from slidernet.io.store import check_output_dir
+from slidernet.io.store import check_output_dir, locked_folder, read_identity_file
 from slidernet.solver import Scene, record_times
 
 if sys.version_info >= (3, 11):
@@ -376,7 +376,19 @@ def sweep(
     """
     grid = _checked_grid(grid)
     base = _base_dict(config)
-    folder = None if out is None else Path(out)
+    options = {"progress": progress, "on_realization": on_realization, "resume": resume, "workers": workers,
+               "scheduler": scheduler, "overwrite": overwrite, "scheduler_timeout": scheduler_timeout}
+    if out is None:
+        return _sweep(base, grid, None, **options)
+    # One process at a time in the folder: a second sweep (or --overwrite) must not touch a sweep still going.
+    with locked_folder(Path(out)):
+        return _sweep(base, grid, Path(out), **options)
+
+
+def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None, *, progress: bool | None,
+           on_realization: Callable[[int, int], None] | None, resume: bool, workers: int | None,
+           scheduler: str | None, overwrite: bool, scheduler_timeout: float | None) -> xr.Dataset | xr.DataTree:
+    """:func:`sweep` of a checked grid, in ``folder`` (whose lock the caller holds) or in memory."""
     identity = _identity(base, grid)
     seed = base.get("seed")
     if folder is not None:
@@ -490,10 +502,8 @@ def _check_folder(folder: Path, identity: dict[str, Any], resume: bool) -> int |
         return None
     if not path.exists():
         raise CheckpointError(f"Nothing to resume in {str(folder)!r}: it has no {_SWEEP_JSON}.")
-    try:
-        stored = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise CheckpointError(f"The sweep file {str(path)!r} cannot be read: {exc}") from None
+    stored = read_identity_file(path, {"config": dict, "sweep": dict, "slidernet_version": str, "seed": int},
+                                "a sweep")
     for what, name in (("config", "base configuration"), ("sweep", "grid"),
                        ("slidernet_version", "slidernet version")):
         if stored.get(what) != identity[what]:

@@ -31,13 +31,14 @@ from __future__ import annotations
 import json
 import os
 import zipfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from slidernet.errors import CheckpointError, SnapshotError
-from slidernet.io import atomic_output
+from slidernet.errors import CheckpointError, OutputError, SnapshotError
+from slidernet.io.netcdf import atomic_output, reason
 from slidernet.solver import Realization, Scene
 from slidernet.solver.snapshot import Snapshot
 
@@ -79,6 +80,9 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
     ------
     CheckpointError
         If ``meta`` is not JSON-serializable.
+    OutputError
+        If the file cannot be written (a full disk, the file size limit),
+        naming it.
     RuntimeError
         If ``real`` holds a piece of state that its snapshot does not know.
 
@@ -108,18 +112,7 @@ def save_realization(real: Realization, path: str | Path, meta: dict[str, Any]) 
         raise CheckpointError(f"The checkpoint meta must be JSON-serializable: {exc}.") from None
     arrays = {"header": np.frombuffer(text.encode("utf-8"), dtype=np.uint8)}
     arrays.update(snap.arrays)
-    odd = sorted(key for key, a in arrays.items() if a.dtype.kind not in "biuf")
-    if odd:  # np.savez would pickle them, and load_realization refuses pickles
-        raise CheckpointError(f"The checkpoint arrays {odd} are not numeric.")
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        with open(tmp, "wb") as fh:  # a file object: np.savez would append ".npz" to a name
-            np.savez(fh, **arrays)
-            fh.flush()
-            # The rename is atomic, but only data on disk survives a machine failure.
-            os.fsync(fh.fileno())
-    _fsync_folder(path.parent)
-    return path
+    return write_arrays(path, arrays)
 
 
 def load_realization(scene: Scene, seed_seq: np.random.SeedSequence, path: str | Path,
@@ -176,27 +169,99 @@ def checkpoint_info(path: str | Path) -> dict[str, Any]:
     return _read(Path(path))[0]
 
 
-def _read(path: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """The header and the arrays of a checkpoint file, every array read (so every CRC checked)."""
-    with open(path, "rb") as fh:
-        if fh.read(6) == b"\x93NUMPY":
-            raise CheckpointError(f"The file {str(path)!r} is a single .npy array, not a slidernet checkpoint.")
+def write_arrays(path: str | Path, arrays: dict[str, np.ndarray]) -> Path:
+    """Write named numeric arrays to one ``.npz`` file, atomically and durably (the file of every checkpoint).
+
+    The file is written under a temporary name, flushed to disk, then
+    renamed over ``path``: an interrupted write leaves the previous file as
+    it was, and a machine failure after the return loses nothing.
+
+    Raises
+    ------
+    CheckpointError
+        If an array is not numeric (``np.savez`` would pickle it, and
+        :func:`read_arrays` refuses pickles).
+    OutputError
+        If the file cannot be written (a full disk, the file size limit:
+        ``ulimit -f``), naming it and the OS's reason.
+    """
+    odd = sorted(key for key, a in arrays.items() if a.dtype.kind not in "biuf")
+    if odd:
+        raise CheckpointError(f"The checkpoint arrays {odd} are not numeric.")
+    path = Path(path)
     try:
-        # numpy reads a member only up to the length its .npy header gives, and zipfile checks a
-        # CRC only at the end of a member: a damaged header length would go unnoticed (found by
-        # flipping bytes). testzip reads every member to its end.
+        with atomic_output(path) as tmp:
+            with open(tmp, "wb") as fh:  # a file object: np.savez would append ".npz" to a name
+                np.savez(fh, **arrays)
+                fh.flush()
+                # The rename is atomic, but only data on disk survives a machine failure.
+                os.fsync(fh.fileno())
+    except OSError as exc:
+        raise OutputError(f"Cannot write the checkpoint file {str(path)!r}: {reason(exc)}.") from None
+    _fsync_folder(path.parent)
+    return path
+
+
+def check_arrays(path: str | Path) -> None:
+    """Check every CRC-32 of an ``.npz`` file by reading each of its members to the end, in constant memory.
+
+    numpy reads a member only up to the length its ``.npy`` header gives, and
+    zipfile checks a CRC only at the end of a member: a damaged header
+    length would go unnoticed by ``np.load`` alone (found by flipping bytes).
+
+    Raises
+    ------
+    CheckpointError
+        If the file is truncated, corrupt, or not a zip file, naming it.
+    """
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            if fh.read(6) == b"\x93NUMPY":
+                raise CheckpointError(
+                    f"The file {str(path)!r} is a single .npy array, not a slidernet checkpoint.")
         with zipfile.ZipFile(path) as zf:
             damaged = zf.testzip()
         if damaged is not None:
             raise zipfile.BadZipFile(f"bad CRC-32 for {damaged!r}")
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files}
-    except (PermissionError, IsADirectoryError):
+    except (CheckpointError, PermissionError, IsADirectoryError, FileNotFoundError):
         raise
     except Exception as exc:
         # Damage surfaces as many exception types: flipping random bytes of a checkpoint gave
         # BadZipFile, EOFError, NotImplementedError (zipfile), ValueError and TokenError (the .npy header).
         raise _unreadable(path, exc) from None
+
+
+def read_arrays(path: str | Path, names: Sequence[str] | None = None) -> dict[str, np.ndarray]:
+    """The arrays of an ``.npz`` file written by :func:`write_arrays`, read without pickle.
+
+    Parameters
+    ----------
+    path : path
+    names : sequence of str, optional
+        Read only these members (each must be there); None: every member,
+        after :func:`check_arrays` has checked the whole file.
+
+    Raises
+    ------
+    CheckpointError
+        If the file is truncated or corrupt, or lacks a member asked for.
+    """
+    path = Path(path)
+    if names is None:
+        check_arrays(path)
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            return {name: npz[name] for name in (npz.files if names is None else names)}
+    except (PermissionError, IsADirectoryError, FileNotFoundError):
+        raise
+    except Exception as exc:
+        raise _unreadable(path, exc) from None
+
+
+def _read(path: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """The header and the arrays of a checkpoint file, every array read (so every CRC checked)."""
+    arrays = read_arrays(path)
     raw = arrays.pop("header", None)
     try:
         header = json.loads(raw.tobytes().decode("utf-8")) if raw is not None and raw.dtype == np.uint8 else None

@@ -25,6 +25,13 @@ back the same whichever wrote it (:func:`read_result`):
   :data:`MAX_CHUNK_BYTES` a chunk), a scalar is contiguous; nothing is
   compressed; ``event`` and ``creep_event`` are unlimited (:data:`UNLIMITED`:
   a streamed run learns their lengths only at its end);
+- every chunk carries HDF5's Fletcher-32 checksum (``fletcher32``), which the
+  library checks whenever the chunk is read; a scalar (contiguous: HDF5 has
+  no checksum for it) carries the CRC-32 of its value's bytes in the
+  attribute :data:`SCALAR_CRC` instead. :func:`read_result` reads every
+  variable, so a flipped bit anywhere in the data is a
+  :class:`~slidernet.errors.ResultError` naming the file and the variable,
+  never a silent wrong value;
 - attributes are text or numbers (:func:`check_attrs`), written as netCDF4
   writes them (a string as text, an int as int64, a float as float64); a
   coordinate that is not a dimension's is named in the ``coordinates``
@@ -38,14 +45,19 @@ import json
 import math
 import numbers
 import os
+import re
+import shutil
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+import zlib
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
+
+from slidernet.errors import OutputError, ResultError, SlidernetError
 
 
 @contextmanager
@@ -69,6 +81,39 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
         raise
 
 
+# The name of a temporary file of atomic_output: "." + the target's name + mkstemp's 8 random characters.
+_TEMPORARY = re.compile(r"\.(?P<target>.+)\.[A-Za-z0-9_]{8}\.tmp")
+
+
+def remove_temporaries(folder: str | Path) -> list[Path]:
+    """Remove what :func:`atomic_output` (or a folder's removal) left in ``folder`` when its process was killed.
+
+    A process that dies in the middle of a write cannot remove its temporary
+    file. Call this only while no other process writes in ``folder``: the
+    caller holds the folder's lock (:class:`slidernet.io.store.FolderLock`).
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    removed = [p for p in folder.iterdir() if _TEMPORARY.fullmatch(p.name)]
+    for p in removed:
+        if p.is_dir():  # a checkpoint folder being removed (slidernet.io.store.RunStore.remove)
+            shutil.rmtree(p, ignore_errors=True)
+        else:
+            p.unlink(missing_ok=True)
+    return removed
+
+
+def reason(exc: OSError) -> str:
+    """The OS's words for an error, without the traceback's chain."""
+    return exc.strerror or str(exc)
+
+
 def _umask() -> int:
     # Reading the umask means setting it; put it straight back.
     mask = os.umask(0o022)
@@ -90,6 +135,11 @@ UNLIMITED: tuple[str, ...] = ("event", "creep_event")
 #: realizations of 1e5 recorded times would be 819 MB, read whole for one value.
 MAX_CHUNK_BYTES = 16 * 2**20
 
+#: The attribute of a scalar variable that holds the CRC-32 of its value (8 hex digits of the value's
+#: little-endian bytes): HDF5 keeps no checksum for a contiguous variable. Written by both writers,
+#: checked and removed by :func:`read_result`.
+SCALAR_CRC = "crc32"
+
 
 def variable_encoding(dims: Sequence[str], shape: Sequence[int], dtype: np.dtype) -> dict[str, Any]:
     """How one variable is stored: the one rule of both result writers.
@@ -108,9 +158,10 @@ def variable_encoding(dims: Sequence[str], shape: Sequence[int], dtype: np.dtype
     -------
     dict
         xarray's encoding keys for the netCDF4 engine: ``dtype`` (where this
-        rule sets it), ``_FillValue``, ``zlib``, ``contiguous`` and
-        ``chunksizes``. A dtype other than a number or text (dates, say) is
-        left to xarray's own conventions, and refused by :func:`result_writer`.
+        rule sets it), ``_FillValue``, ``zlib``, ``fletcher32``,
+        ``contiguous`` and ``chunksizes``. A dtype other than a number or
+        text (dates, say) is left to xarray's own conventions, and refused by
+        :func:`result_writer`.
 
     >>> variable_encoding(("realization", "t"), (3000, 41), np.dtype(np.int64))["chunksizes"]
     (1024, 41)
@@ -119,7 +170,7 @@ def variable_encoding(dims: Sequence[str], shape: Sequence[int], dtype: np.dtype
     (dtype('float64'), True)
     """
     dtype = np.dtype(dtype)
-    enc: dict[str, Any] = {"zlib": False}
+    enc: dict[str, Any] = {"zlib": False, "fletcher32": False}
     if dtype.kind == "f":
         enc.update(dtype=dtype, _FillValue=dtype.type(np.nan))
     elif dtype.kind in "iu":
@@ -137,7 +188,8 @@ def variable_encoding(dims: Sequence[str], shape: Sequence[int], dtype: np.dtype
     while math.prod(chunks) * itemsize > MAX_CHUNK_BYTES and max(chunks) > 1:
         k = chunks.index(max(chunks))
         chunks[k] = (chunks[k] + 1) // 2
-    enc.update(contiguous=False, chunksizes=tuple(chunks))
+    # A checksum per chunk (4 bytes), checked by HDF5 at every read of the chunk.
+    enc.update(contiguous=False, chunksizes=tuple(chunks), fletcher32=True)
     return enc
 
 
@@ -182,22 +234,71 @@ def stored(name: str, dims: Sequence[str], data: Any, attrs: Mapping[str, Any],
     -------
     data : array_like
     attrs : dict
-        With ``dtype = "bool"`` for a bool, and ``coordinates``, the
+        With ``dtype = "bool"`` for a bool, ``coordinates``, the
         coordinates of ``aux`` that label this variable (those whose
-        dimensions are all among its own; a coordinate lists none).
+        dimensions are all among its own; a coordinate lists none), and for
+        a numeric scalar :data:`SCALAR_CRC`, its checksum (any such
+        attribute given is replaced: it belongs to the value stored now).
     """
     attrs = dict(attrs)
+    attrs.pop(SCALAR_CRC, None)
     check_attrs(attrs, f"the variable {name!r}")
     if not hasattr(data, "dtype"):
         data = np.asarray(data)
     if data.dtype == bool:
         data = np.asarray(data).astype(np.int8)
         attrs["dtype"] = "bool"
+    if not dims and data.dtype.kind in "biuf":
+        attrs[SCALAR_CRC] = _crc32(np.asarray(data))
     if name not in aux and name not in dims and "coordinates" not in attrs:
         labels = sorted(c for c, c_dims in aux.items() if set(c_dims) <= set(dims))
         if labels:
             attrs["coordinates"] = " ".join(labels)
     return data, attrs
+
+
+def _crc32(value: np.ndarray) -> str:
+    """The CRC-32 of a number's little-endian bytes, as 8 hex digits (:data:`SCALAR_CRC`)."""
+    little = np.ascontiguousarray(value, dtype=value.dtype.newbyteorder("<"))
+    return f"{zlib.crc32(little.tobytes()):08x}"
+
+
+@contextmanager
+def _netcdf_output(path: str | Path) -> Iterator[Path]:
+    """:func:`atomic_output` for a netCDF file: a failed write is an :class:`OutputError` naming ``path``.
+
+    netCDF reports a full disk or a file size limit as ``RuntimeError: NetCDF:
+    HDF error``, naming neither the file nor the cause; the cause is found
+    here from the limit and the free space (:func:`_why_not_written`).
+    """
+    path = Path(path)
+    with atomic_output(path) as tmp:
+        try:
+            yield tmp
+        except (RuntimeError, OSError) as exc:
+            if isinstance(exc, SlidernetError) or not (type(exc) is RuntimeError or isinstance(exc, OSError)):
+                raise  # an error of slidernet's own, or a plugin's: not the file's
+            raise OutputError(f"Cannot write the result file {str(path)!r}: {_why_not_written(tmp, exc)}.") \
+                from None
+
+
+def _why_not_written(tmp: Path, exc: BaseException) -> str:
+    """Why a write to ``tmp`` failed, in words: the size limit (ulimit -f), a full disk, or the library's."""
+    said = (reason(exc) if isinstance(exc, OSError) else str(exc)) or type(exc).__name__
+    try:
+        import resource  # POSIX only
+
+        size = tmp.stat().st_size
+        soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        stat = os.statvfs(tmp.parent)
+    except (ImportError, OSError, AttributeError):
+        return said
+    # A write that crosses the limit stops at it; HDF5 writes at most a chunk (MAX_CHUNK_BYTES) at a time.
+    if soft != resource.RLIM_INFINITY and size + MAX_CHUNK_BYTES >= soft:
+        return f"the file reached this process's file size limit (ulimit -f: {soft} bytes) ({said})"
+    if stat.f_bavail * stat.f_frsize < MAX_CHUNK_BYTES:
+        return f"the disk is full ({said})"
+    return said
 
 
 def write_netcdf(result: xr.Dataset | xr.DataTree, path: str | Path) -> Path:
@@ -232,11 +333,11 @@ def write_netcdf(result: xr.Dataset | xr.DataTree, path: str | Path) -> Path:
             groups[node.path], encodings[node.path] = _stored_dataset(node.to_dataset(inherit=False), owner)
             unlimited[node.path] = [d for d in UNLIMITED if d in groups[node.path].dims]
         tree = xr.DataTree.from_dict(groups)
-        with atomic_output(path) as tmp:
+        with _netcdf_output(path) as tmp:
             tree.to_netcdf(tmp, engine="netcdf4", encoding=encodings, unlimited_dims=unlimited)
         return Path(path)
     out, encoding = _stored_dataset(result, "the dataset")
-    with atomic_output(path) as tmp:
+    with _netcdf_output(path) as tmp:
         out.to_netcdf(tmp, engine="netcdf4", encoding=encoding,
                       unlimited_dims=[d for d in UNLIMITED if d in out.dims])
     return Path(path)
@@ -321,8 +422,8 @@ class ResultWriter:
         data, attrs = stored(name, dims, data, attrs, self._aux)
         enc = variable_encoding(dims, [self.size(d) for d in dims], data.dtype)
         var = self._nc.createVariable(name, enc.get("dtype", data.dtype), dims, zlib=enc["zlib"],
-                                      contiguous=enc["contiguous"], chunksizes=enc.get("chunksizes"),
-                                      fill_value=enc["_FillValue"])
+                                      fletcher32=enc["fletcher32"], contiguous=enc["contiguous"],
+                                      chunksizes=enc.get("chunksizes"), fill_value=enc["_FillValue"])
         for key, value in attrs.items():
             _set_attribute(var, key, value)
         self._labelled.update(attrs.get("coordinates", "").split())
@@ -356,7 +457,14 @@ def result_writer(path: str | Path) -> Iterator[ResultWriter]:
 
     The file is renamed over ``path`` when the block ends, and removed
     instead on any exception (Ctrl-C included): ``path`` is never half
-    written.
+    written. A scalar is written whole by its first :meth:`ResultWriter.write`
+    (its checksum, :data:`SCALAR_CRC`, is that value's).
+
+    Raises
+    ------
+    OutputError
+        If the file cannot be written (a full disk, the file size limit),
+        naming it and the cause.
 
     Parameters
     ----------
@@ -376,7 +484,7 @@ def result_writer(path: str | Path) -> Iterator[ResultWriter]:
     """
     import netCDF4
 
-    with atomic_output(path) as tmp, netCDF4.Dataset(tmp, "w", format="NETCDF4") as nc:
+    with _netcdf_output(path) as tmp, netCDF4.Dataset(tmp, "w", format="NETCDF4") as nc:
         writer = ResultWriter(nc)
         yield writer
         writer._finish()
@@ -391,7 +499,7 @@ def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
 
 
 def read_result(path: str | Path) -> xr.Dataset | xr.DataTree:
-    """Load a result file fully into memory (the file is closed on return).
+    """Load a result file fully into memory, every checksum checked (the file is closed on return).
 
     Parameters
     ----------
@@ -408,19 +516,102 @@ def read_result(path: str | Path) -> xr.Dataset | xr.DataTree:
         sweep whose points differ in number of nodes: the stacked variables
         at the root, each point's per-node variables in its group
         ``point_<i>``; :mod:`slidernet.ensemble.sweep`).
+
+    Raises
+    ------
+    ResultError
+        If the file is not a netCDF file, is truncated, or a variable's data
+        fail their checksum (``fletcher32``, or :data:`SCALAR_CRC` for a
+        scalar), naming the file and the variable. A file written before
+        the checksums were (no ``fletcher32``) is read without them.
     """
-    if _has_groups(path):
-        with xr.open_datatree(path, engine="netcdf4") as tree:
-            return tree.load()
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        return ds.load()
+    path = Path(path)
+    groups = _checked_scalars(path)
+    try:
+        if groups:
+            with xr.open_datatree(path, engine="netcdf4") as tree:
+                for node in tree.subtree:
+                    _load_each(node.dataset.variables, path, node.path)
+                result = tree.load()
+                for node in result.subtree:
+                    _drop_crc(node.dataset.variables.values())
+                return result
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            _load_each(ds.variables, path, "/")
+            result = ds.load()
+    except ResultError:
+        raise
+    except _DAMAGE as exc:
+        raise _damaged(path, exc) from None
+    _drop_crc(result.variables.values())
+    return result
 
 
-def _has_groups(path: str | Path) -> bool:
+def open_result(path: str | Path) -> xr.Dataset:
+    """Open a result file without groups lazily (``xarray.open_dataset``); its scalars' checksums checked.
+
+    The chunks' checksums are checked by HDF5 as the data are read. Close
+    the dataset (or use it in a ``with`` block) when done.
+    """
+    path = Path(path)
+    _checked_scalars(path)
+    ds = xr.open_dataset(path, engine="netcdf4")
+    _drop_crc(ds.variables.values())
+    return ds
+
+
+def _load_each(variables: Mapping[Any, xr.Variable], path: Path, group: str) -> None:
+    """Read every variable once, so that a checksum that fails names its variable."""
+    for name, var in variables.items():
+        try:
+            var.load()
+        except _DAMAGE as exc:
+            where = f"{name!r}" if group == "/" else f"{name!r} of the group {group!r}"
+            raise ResultError(
+                f"The result file {str(path)!r} is damaged: the data of {where} cannot be read back intact "
+                f"(a chunk fails its fletcher32 checksum, or the file is truncated: {exc})."
+            ) from None
+
+
+def _checked_scalars(path: Path) -> bool:
+    """Check the :data:`SCALAR_CRC` of every scalar, in every group; return whether the file has groups."""
     import netCDF4
 
-    with netCDF4.Dataset(path, "r") as nc:
-        return bool(nc.groups)
+    try:
+        with netCDF4.Dataset(path, "r") as nc:
+            todo = [nc]
+            while todo:
+                group = todo.pop()
+                todo.extend(group.groups.values())
+                for name, var in group.variables.items():
+                    if var.dimensions or SCALAR_CRC not in var.ncattrs():
+                        continue
+                    var.set_auto_maskandscale(False)
+                    if _crc32(np.asarray(var[...])) != var.getncattr(SCALAR_CRC):
+                        where = f"{name!r}" if group is nc else f"{name!r} of the group {group.path!r}"
+                        raise ResultError(f"The result file {str(path)!r} is damaged: the value of {where} fails "
+                                          f"its checksum ({SCALAR_CRC}).")
+            return bool(nc.groups)
+    except (FileNotFoundError, ResultError):
+        raise
+    except _DAMAGE as exc:
+        raise _damaged(path, exc) from None
+
+
+# What netCDF4 and xarray raise on a damaged file: HDF5 checks its metadata's checksums too, and a
+# flipped bit there gave "AttributeError: NetCDF: Can't open HDF5 attribute" (found by flipping bits).
+_DAMAGE = (OSError, RuntimeError, AttributeError, KeyError, ValueError, IndexError)
+
+
+def _damaged(path: Path, exc: BaseException) -> ResultError:
+    return ResultError(f"The result file {str(path)!r} cannot be read: it is not a netCDF file, or it is "
+                       f"truncated or damaged ({exc}).")
+
+
+def _drop_crc(variables: Iterable[xr.Variable]) -> None:
+    """Remove :data:`SCALAR_CRC` from the attributes read back: it describes the file, not the value."""
+    for var in variables:
+        var.attrs.pop(SCALAR_CRC, None)
 
 
 def result_config(ds: xr.Dataset | xr.DataTree) -> dict:

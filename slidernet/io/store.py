@@ -1,42 +1,63 @@
 """The checkpoint folder of a run: what is done, kept so that a killed run loses (almost) nothing.
 
-Layout of ``DIR/checkpoint/`` (plain numeric files and JSON; no pickle)::
+Layout of an output directory ``DIR`` while its run is unfinished (plain
+numeric files and JSON; no pickle)::
 
-    run.json                 what identifies the run: the configuration (without
-                             its execution table), the resolved seed, the
-                             number of realizations, the slidernet version
-    block-<first>-<k>.npz    finished realizations, written together: their
-                             indices, then every record stacked (ragged records,
-                             the event catalogue, concatenated with offsets);
+    checkpoint/
+      .slidernet.lock        the run's lock, while a process works on it (FolderLock)
+      run.json               the run's identity: the configuration (without its
+                             execution table), the resolved seed, the number of
+                             realizations, the slidernet version, the SHA-256 of
+                             every input file (``inputs``), and ``digest``, the
+                             SHA-256 of all of these
+      block-<first>-<k>.npz  finished realizations, written together: their
+                             indices, the run's digest (``run``), then every
+                             record stacked (ragged records, the event catalogue,
+                             concatenated with offsets);
                              block-<first>-<k>-<j>.npz where that name is taken
                              (j = 1, 2, ...; a realization in two blocks is read
                              from the one written last)
-    partial-<r>.npz          a realization in progress (slidernet.io.checkpoint)
+      partial-<r>.npz        a realization in progress (slidernet.io.checkpoint),
+                             the run's digest in its meta
 
 Every file is written to a temporary name and renamed, so a kill at any time
-leaves either the old file or the new one. The set of finished realizations is
-read from the blocks themselves (not from a list that could disagree with
-them). Once ``result.nc`` is written the folder is removed.
+leaves either the old file or the new one; what a killed process left under a
+temporary name is removed by the next run in the folder, which holds the lock.
+The set of finished realizations is read from the blocks themselves (not from
+a list that could disagree with them). A block or a partial file is read only
+if it names this run's digest. Once ``result.nc`` is written the checkpoint
+folder is removed.
 """
 
 from __future__ import annotations
 
+import errno
+import hashlib
 import json
+import os
 import re
+import secrets
 import shutil
-from collections.abc import Iterator
+import warnings
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from slidernet.errors import CheckpointError, OutputError
-from slidernet.io import atomic_output
+from slidernet.errors import CheckpointError, CheckpointWarning, FolderInUseError, OutputError
+from slidernet.io.checkpoint import check_arrays, checkpoint_info, read_arrays, write_arrays
+from slidernet.io.netcdf import atomic_output, reason, remove_temporaries
 
 Record = dict[str, Any]
 
 # A block's name; the suffix -<j> tells apart blocks whose first realization and size agree.
 _BLOCK = re.compile(r"block-(\d+)-(\d+)(?:-(\d+))?\.npz")
+_PARTIAL = re.compile(r"partial-(\d+)\.npz")
+
+#: The keys of a run's identity (``run.json`` holds them and ``digest``).
+IDENTITY_KEYS = ("config", "seed", "realizations", "slidernet_version", "inputs")
 
 
 def _block_order(path: Path) -> tuple[int, int]:
@@ -55,6 +76,169 @@ def _flat_diff(a: Any, b: Any, prefix: str = "") -> list[str]:
     return [] if a == b else [f"{prefix[:-1]} ({json.dumps(a)} in the checkpoint, {json.dumps(b)} now)"]
 
 
+def run_digest(identity: Mapping[str, Any]) -> str:
+    """The SHA-256 (hex) of a run's identity (:data:`IDENTITY_KEYS`), in canonical JSON: what names a run.
+
+    Every file of a run's checkpoint carries it, and no file that carries
+    another is ever read for this run.
+    """
+    canonical = json.dumps({key: identity[key] for key in IDENTITY_KEYS}, sort_keys=True,
+                           separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
+
+
+def file_digest(path: str | Path) -> str:
+    """The SHA-256 (hex) of a file's bytes, read in pieces of 1 MiB.
+
+    Raises
+    ------
+    CheckpointError
+        If the file cannot be read, naming it.
+    """
+    sha = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for piece in iter(lambda: fh.read(1 << 20), b""):
+                sha.update(piece)
+    except OSError as exc:
+        raise CheckpointError(f"The input file {str(path)!r} cannot be read: {reason(exc)}.") from None
+    return sha.hexdigest()
+
+
+class FolderLock:
+    """An advisory lock on a folder that a run (its checkpoint folder) or a sweep works in: one process at a time.
+
+    ``flock`` on the file ``folder/.slidernet.lock``, opened for writing (so
+    that NFS, which emulates it with byte-range locks, locks it too). The
+    operating system releases the lock when the process that holds it ends,
+    however it ends (kill -9 included), so a lock never outlives its run and
+    never blocks a resume; forked worker processes share it. The file holds
+    the holder's process id, for the message of a process that is refused,
+    and is removed on :meth:`release`.
+
+    Parameters
+    ----------
+    folder : path
+        An existing folder.
+
+    Raises
+    ------
+    FolderInUseError
+        From :meth:`acquire`, if another process holds the lock.
+    """
+
+    NAME = ".slidernet.lock"
+
+    def __init__(self, folder: str | Path) -> None:
+        self.folder = Path(folder)
+        self.path = self.folder / self.NAME
+        self._fd: int | None = None
+
+    @property
+    def held(self) -> bool:
+        """True while this object holds the lock."""
+        return self._fd is not None
+
+    def acquire(self) -> None:
+        """Take the lock, or refuse at once (never wait) if another process holds it.
+
+        Where the file system cannot lock (``flock`` unsupported), a
+        :class:`~slidernet.errors.CheckpointWarning` says so and the run goes
+        on unlocked.
+        """
+        import fcntl  # POSIX; the module is imported where a lock is taken
+
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+            except OSError as exc:
+                raise OutputError(f"Cannot write in the output directory {str(self.folder)!r}: "
+                                  f"{reason(exc)}.") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = _read_pid(fd)
+                os.close(fd)
+                who = f"process {holder}" if holder else "another process"
+                raise FolderInUseError(
+                    f"{str(self.folder)!r} is in use: a slidernet run is still going there ({who} holds its lock "
+                    f"{str(self.path)!r}). Wait for it to end, or stop it, before you resume it or start another "
+                    "run there.") from None
+            except OSError as exc:
+                os.close(fd)
+                if exc.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EBADF, errno.EINVAL):
+                    raise
+                warnings.warn(f"The output directory {str(self.folder)!r} cannot be locked on this file system "
+                              f"({reason(exc)}): nothing stops a second run from working in it at the same time.",
+                              CheckpointWarning, stacklevel=3)
+                return
+            # The file may have been removed by its last holder between our open and our lock: then we
+            # hold a lock on a file that nobody else will find. Lock the file at the path instead.
+            try:
+                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self._fd = fd
+
+    def release(self) -> None:
+        """Remove the lock file and let the lock go (the file is removed first, while it is still held)."""
+        if self._fd is None:
+            return
+        self.path.unlink(missing_ok=True)
+        os.close(self._fd)
+        self._fd = None
+
+    def __enter__(self) -> FolderLock:
+        self.acquire()
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.release()
+
+
+@contextmanager
+def locked_folder(folder: str | Path) -> Iterator[Path]:
+    """Hold ``folder``'s :class:`FolderLock` for the block; the folder is made if missing.
+
+    Under the lock, what killed processes left there under a temporary name
+    is removed first. A folder made here and left empty by the block is
+    removed again (a run refused before any work leaves no folder behind).
+
+    Raises
+    ------
+    OutputError
+        If ``folder`` is a file or cannot be made.
+    FolderInUseError
+        If another process holds the lock.
+    """
+    folder = Path(folder)
+    check_output_dir(folder)
+    made = not folder.exists()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"Cannot create the output directory {str(folder)!r}: {reason(exc)}.") from None
+    try:
+        with FolderLock(folder):
+            remove_temporaries(folder)
+            yield folder
+    finally:
+        if made and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+
+
+def _read_pid(fd: int) -> int | None:
+    try:
+        return int(os.pread(fd, 32, 0).decode().strip() or "0") or None
+    except (OSError, ValueError):
+        return None
+
+
 class RunStore:
     """The checkpoint folder ``out_dir / "checkpoint"`` of one run.
 
@@ -64,11 +248,19 @@ class RunStore:
         The run's output directory.
     identity : dict
         ``config`` (the configuration as JSON-ready dict, without ``execution``;
-        its ``seed`` as the user gave it), ``seed`` (resolved), ``realizations``
-        and ``slidernet_version``.
+        its ``seed`` as the user gave it), ``seed`` (resolved), ``realizations``,
+        ``slidernet_version`` and ``inputs`` (input file field -> SHA-256).
     resume : bool
         Continue the run found there. Without it, a folder that holds an
         interrupted run is refused rather than overwritten.
+    overwrite : bool
+        Start again: what the folder holds of an earlier run (finished or
+        not) is replaced.
+
+    Notes
+    -----
+    :meth:`open` takes the folder's lock (:class:`FolderLock`) and
+    :meth:`close` lets it go: call ``close`` however the run ends.
     """
 
     def __init__(self, out_dir: str | Path, identity: dict[str, Any], resume: bool,
@@ -79,10 +271,25 @@ class RunStore:
         self.overwrite = overwrite
         self._buffer: dict[int, Record] = {}
         self._created: list[Path] = []  # folders this run made, outermost first (undone by abandon)
+        self._wrote_identity = False  # run.json written by this run (undone by abandon)
+        # The lock lives in the checkpoint folder, so that removing the folder at the end of the run
+        # (one rename, remove) also ends the lock: a finished run leaves no lock file behind.
+        self._lock = FolderLock(self.dir)
+
+    @property
+    def digest(self) -> str:
+        """The run's digest (:func:`run_digest`): in every file of its checkpoint."""
+        return run_digest(self.identity)
 
     # -- opening ---------------------------------------------------------
     def open(self) -> int:
-        """Create or check the folder; return the seed to use (the stored one on resume).
+        """Lock the folder, create or check it; return the seed to use (the stored one on resume).
+
+        On resume every block and partial file is checked (its CRCs, its
+        run's digest) before any work: a damaged one is removed, with a
+        :class:`~slidernet.errors.CheckpointWarning` naming it, and its
+        realizations are computed again (every realization is a function of
+        the seed alone, so this gives the same bits).
 
         Raises
         ------
@@ -90,64 +297,130 @@ class RunStore:
             If the output directory is a file or cannot be created, or it
             holds a finished ``result.nc`` and neither ``overwrite`` nor a
             run to resume is there.
+        FolderInUseError
+            If a run is still going in the folder (another process holds its lock).
         CheckpointError
             If it holds an interrupted run and ``resume`` is not set, or
-            another run's checkpoint, or nothing to resume.
+            another run's checkpoint, or nothing to resume; if ``run.json``
+            is damaged; on resume, if the configuration, an input file or
+            the version differ from the run's.
         """
         out = self.dir.parent
         check_output_dir(out)
+        existed = self.dir.is_dir()
+        self._make_dirs(self.dir)
+        try:
+            self._lock.acquire()
+        except BaseException:
+            self.abandon()
+            raise
+        try:
+            return self._open_locked(existed)
+        except BaseException:
+            self.abandon()
+            self.close()
+            raise
+
+    def _open_locked(self, existed: bool) -> int:
+        """:meth:`open` under the lock; ``existed``: the checkpoint folder was there before."""
+        out = self.dir.parent
+        # Under the lock no other process writes here: a temporary file is what a killed one left.
+        self.remove_temporaries()
         run_json = self.dir / "run.json"
         result = out / "result.nc"
-        if result.exists() and not run_json.exists() and not (self.overwrite or self.resume):
+        if self.overwrite and not self.resume:
+            for path in self.dir.iterdir():  # asked for: whatever run was there is replaced (the lock stays)
+                if path != self._lock.path:
+                    shutil.rmtree(path) if path.is_dir() else path.unlink()
+        if run_json.exists():
+            stored = _read_identity(run_json)
+            if not self.resume:
+                done = len(self.done(strict=False))
+                raise CheckpointError(
+                    f"{str(out)!r} holds an interrupted run ({done} of {stored['realizations']} realizations "
+                    f"done; no process is working on it). Continue it with --resume, or start again with "
+                    f"--overwrite.")
+            self._check_same_run(stored)
+            self.identity["seed"] = stored["seed"]
+            self._check_files()
+            return int(stored["seed"])
+        saved = self._saved_files()
+        if saved:
+            raise CheckpointError(
+                f"{str(self.dir)!r} holds {len(saved)} checkpoint files (e.g. {saved[0].name!r}) but no run.json, "
+                "the run's identity: they cannot be matched to a configuration and are never read. Start again "
+                "with --overwrite, or use another output directory.")
+        if self.resume:
+            if existed:
+                why = "its checkpoint folder holds no run (no run.json, no saved realization)"
+            else:
+                why = "it has no checkpoint folder" + (" (its run is finished: result.nc is there)"
+                                                       if result.exists() else "")
+            raise CheckpointError(f"Nothing to resume in {str(out)!r}: {why}.")
+        if result.exists() and not self.overwrite:
             raise OutputError(
                 f"{str(out)!r} holds a finished result ({str(result)!r}); it is not replaced silently. "
                 "Use --overwrite to replace it, or another output directory."
             )
-        if run_json.exists() and self.overwrite and not self.resume:
-            shutil.rmtree(self.dir)  # asked for: the interrupted run there is replaced
-        if run_json.exists():
-            try:
-                stored = json.loads(run_json.read_text())
-            except (OSError, ValueError) as exc:
-                raise CheckpointError(f"The checkpoint {str(run_json)!r} cannot be read: {exc}") from None
-            done = len(self.done())
-            if not self.resume:
-                raise CheckpointError(
-                    f"{str(self.dir.parent)!r} holds an interrupted run ({done} of {stored.get('realizations')} "
-                    f"realizations done). Continue it with --resume, or start again with --overwrite."
-                )
-            diff = _flat_diff(stored["config"], self.identity["config"])
-            if stored.get("realizations") != self.identity["realizations"]:
-                diff.append(f"realizations ({stored.get('realizations')} in the checkpoint, "
-                            f"{self.identity['realizations']} now)")
-            if diff:
-                raise CheckpointError(
-                    "Cannot resume: the configuration differs from the checkpointed run's in "
-                    + "; ".join(diff) + ". Resume with the same configuration, or use another output directory."
-                )
-            if stored.get("slidernet_version") != self.identity["slidernet_version"]:
-                raise CheckpointError(
-                    f"Cannot resume: the checkpoint was written by slidernet {stored.get('slidernet_version')}, "
-                    f"this is {self.identity['slidernet_version']}; results would not be bit-identical."
-                )
-            self.identity["seed"] = stored["seed"]
-            return int(stored["seed"])
-        if self.resume:
-            finished = " (its run is finished: result.nc is there)" if result.exists() else ""
-            raise CheckpointError(
-                f"Nothing to resume in {str(self.dir.parent)!r}: it has no checkpoint folder{finished}.")
-        self._make_dirs()
+        self.identity["digest"] = self.digest
         try:
             with atomic_output(run_json) as tmp:
                 tmp.write_text(json.dumps(self.identity, indent=1, sort_keys=True))
         except OSError as exc:
-            self.abandon()
             raise OutputError(f"Cannot write in the output directory {str(out)!r}: {reason(exc)}.") from None
+        self._wrote_identity = True
         return int(self.identity["seed"])
 
-    def _make_dirs(self) -> None:
-        """Create the checkpoint folder and its missing parents, remembering which were made here."""
-        missing = [p for p in (self.dir, *self.dir.parents) if not p.exists()][::-1]
+    def _check_same_run(self, stored: dict[str, Any]) -> None:
+        """Refuse to resume a run of another configuration, other input files or another version."""
+        diff = _flat_diff(stored["config"], self.identity["config"])
+        if stored["realizations"] != self.identity["realizations"]:
+            diff.append(f"realizations ({stored['realizations']} in the checkpoint, "
+                        f"{self.identity['realizations']} now)")
+        if diff:
+            raise CheckpointError(
+                "Cannot resume: the configuration differs from the checkpointed run's in "
+                + "; ".join(diff) + ". Resume with the same configuration, or use another output directory."
+            )
+        if stored["slidernet_version"] != self.identity["slidernet_version"]:
+            raise CheckpointError(
+                f"Cannot resume: the checkpoint was written by slidernet {stored['slidernet_version']}, "
+                f"this is {self.identity['slidernet_version']}; results would not be bit-identical."
+            )
+        changed = changed_inputs(stored["inputs"], self.identity["inputs"])
+        if changed:
+            raise CheckpointError(
+                f"Cannot resume: an input file changed since the run started: {changed}. The saved "
+                "realizations were computed from the old contents; restore them, or start again with --overwrite.")
+
+    def _check_files(self) -> None:
+        """Check every block and partial file before any work (see :meth:`open`)."""
+        digest = self.identity["digest"] = self.digest
+        R = self.identity["realizations"]
+        for path in self._blocks():
+            try:
+                check_arrays(path)
+                arrays = read_arrays(path, ["run", "realization"])
+                idx = arrays["realization"]
+                if idx.ndim != 1 or idx.dtype.kind not in "iu" or ((idx < 0) | (idx >= R)).any():
+                    raise CheckpointError(f"The checkpoint {str(path)!r} lists realizations outside 0 to {R - 1}.")
+            except CheckpointError as exc:
+                _recompute(path, exc, "its realizations are computed again")
+                continue
+            if bytes(arrays["run"]).decode("ascii", "replace") != digest:
+                raise _foreign(path)
+        for path in self._partials():
+            try:
+                meta = checkpoint_info(path).get("meta")
+            except CheckpointError as exc:
+                _recompute(path, exc, "its realization starts again from its beginning")
+                continue
+            if not isinstance(meta, dict) or meta.get("run") != digest:
+                raise _foreign(path)
+
+    def _make_dirs(self, folder: Path) -> None:
+        """Create ``folder`` and its missing parents, remembering which were made here."""
+        missing = [p for p in (folder, *folder.parents) if not p.exists()][::-1]
         for path in missing:
             try:
                 path.mkdir()
@@ -165,37 +438,61 @@ class RunStore:
     def abandon(self) -> None:
         """Undo :meth:`open` after a failure, if nothing worth keeping was saved.
 
-        A run that failed before any realization finished or saved its state
-        leaves the output directory as it found it: the folders it created
-        are removed. Saved work (a block or a partial realization) is kept,
-        so that a fixed run can resume it.
+        A run that failed before any realization was saved (a block or a
+        partial realization on disk) leaves the output directory as it found
+        it: the folders it created are removed. Saved work is kept, so that
+        a fixed run can resume it. Flush the finished realizations first.
         """
-        if self._buffer or (self.dir.exists() and any(
-                _BLOCK.fullmatch(p.name) or p.name.startswith("partial-") for p in self.dir.iterdir())):
+        if self._saved_files():
             return
+        if self._wrote_identity:
+            (self.dir / "run.json").unlink(missing_ok=True)
+            self._wrote_identity = False
         for path in reversed(self._created):
             shutil.rmtree(path, ignore_errors=True)
         self._created.clear()
 
+    def remove_temporaries(self) -> None:
+        """Remove the temporary files of writes that were killed, in the output and checkpoint folders.
+
+        Call this only while the lock is held and no worker of this run writes.
+        """
+        remove_temporaries(self.dir.parent)
+        remove_temporaries(self.dir)
+
+    def close(self) -> None:
+        """Let the folder's lock go (however the run ended; :meth:`open` took it)."""
+        self._lock.release()
+
+    def _saved_files(self) -> list[Path]:
+        return self._blocks() + self._partials()
+
+    def _partials(self) -> list[Path]:
+        return sorted(p for p in self.dir.iterdir() if _PARTIAL.fullmatch(p.name)) if self.dir.is_dir() else []
+
     def partials(self) -> int:
         """The number of realizations saved in progress."""
-        return sum(1 for _ in self.dir.glob("partial-*.npz")) if self.dir.exists() else 0
+        return len(self._partials())
 
     # -- finished realizations -------------------------------------------
     def _blocks(self) -> list[Path]:
-        if not self.dir.exists():
+        if not self.dir.is_dir():
             return []
         return sorted((p for p in self.dir.iterdir() if _BLOCK.fullmatch(p.name)), key=_block_order)
 
-    def done(self) -> dict[int, tuple[Path, int]]:
-        """Finished realization -> (its block, its row in the block)."""
+    def done(self, strict: bool = True) -> dict[int, tuple[Path, int]]:
+        """Finished realization -> (its block, its row in the block).
+
+        ``strict=False`` skips a block that cannot be read instead of raising.
+        """
         out: dict[int, tuple[Path, int]] = {}
         for path in self._blocks():
             try:
-                with np.load(path, allow_pickle=False) as z:
-                    idx = z["realization"]
-            except (OSError, ValueError, KeyError) as exc:
-                raise CheckpointError(f"The checkpoint block {str(path)!r} is damaged: {exc}") from None
+                idx = read_arrays(path, ["realization"])["realization"]
+            except CheckpointError:
+                if strict:
+                    raise
+                continue
             for row, r in enumerate(idx.tolist()):
                 out[r] = (path, row)
         return out
@@ -210,19 +507,26 @@ class RunStore:
         return len(self._buffer)
 
     def flush(self) -> None:
-        """Write the held realizations as one block, then drop their partial files."""
+        """Write the held realizations as one block, then drop their partial files.
+
+        Raises
+        ------
+        OutputError
+            If the block cannot be written (naming it); the realizations
+            stay held.
+        """
         if not self._buffer:
             return
         rs = sorted(self._buffer)
         arrays = _pack([self._buffer[r] for r in rs])
         arrays["realization"] = np.array(rs, np.int64)
+        arrays["run"] = np.frombuffer(self.identity["digest"].encode("ascii"), np.uint8)
         path = self.dir / f"block-{rs[0]:09d}-{len(rs)}.npz"
         k = 0
         while path.exists():  # the same first realization can recur after a resume
             k += 1
             path = self.dir / f"block-{rs[0]:09d}-{len(rs)}-{k}.npz"
-        with atomic_output(path) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+        write_arrays(path, arrays)
         for r in rs:
             self.partial(r).unlink(missing_ok=True)
         self._buffer.clear()
@@ -244,24 +548,105 @@ class RunStore:
             if path not in cache:
                 if len(cache) >= 2:
                     cache.pop(next(iter(cache)))
-                with np.load(path, allow_pickle=False) as z:
-                    cache[path] = _unpack({k: z[k] for k in z.files})
+                arrays = read_arrays(path)
+                arrays.pop("run", None)
+                cache[path] = _unpack(arrays)
             yield cache[path][row]
 
     def remove(self) -> None:
-        """Delete the folder (the run's result is safely written)."""
-        shutil.rmtree(self.dir, ignore_errors=True)
+        """Delete the folder (the run's result is safely written), lock file included.
+
+        The folder is first renamed to a temporary name, in one step: from
+        then on no process sees a run in ``out_dir`` but the finished one,
+        and a kill while the files are removed leaves a temporary folder,
+        removed by the next run there (:func:`~slidernet.io.netcdf.remove_temporaries`).
+        """
+        gone = self.dir.with_name(f".{self.dir.name}.{secrets.token_hex(4)}.tmp")
+        try:
+            os.rename(self.dir, gone)
+        except FileNotFoundError:
+            return
+        shutil.rmtree(gone, ignore_errors=True)
+
+
+def read_identity_file(path: Path, types: Mapping[str, type], what: str) -> dict[str, Any]:
+    """A JSON file that identifies a run or a sweep, checked: a JSON object with these keys of these types.
+
+    Parameters
+    ----------
+    path : Path
+    types : mapping of str to type
+        Each key the file must hold, and the type of its value (a bool is
+        never an int here).
+    what : str
+        What the file identifies, for the message ("a run", "a sweep").
+
+    Raises
+    ------
+    CheckpointError
+        If the file cannot be read, is not JSON, or lacks a key or has one
+        of another type (``{}``, ``[]``, a damaged file), in one line naming
+        it.
+    """
+    try:
+        stored = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise CheckpointError(f"The file {str(path)!r} cannot be read ({exc}); start again with --overwrite.") \
+            from None
+    if not isinstance(stored, dict):
+        wrong = f"a JSON {type(stored).__name__}, not an object"
+    else:
+        bad = [key for key, kind in types.items()
+               if not isinstance(stored.get(key), kind) or isinstance(stored.get(key), bool)]
+        wrong = f"no valid {', '.join(bad)}" if bad else ""
+    if wrong:
+        raise CheckpointError(f"The file {str(path)!r} does not identify {what} ({wrong}): it is damaged, or was "
+                              "written by another program or an earlier slidernet. Start again with --overwrite.")
+    return stored
+
+
+def _read_identity(path: Path) -> dict[str, Any]:
+    """A run.json, checked: its keys and their types, and its digest (a flipped bit changes it)."""
+    types = {"config": dict, "seed": int, "realizations": int, "slidernet_version": str, "inputs": dict,
+             "digest": str}
+    stored = read_identity_file(path, types, "a run")
+    if run_digest(stored) != stored["digest"]:
+        raise CheckpointError(f"The checkpoint {str(path)!r} is damaged: its contents do not match their digest. "
+                              "Start again with --overwrite.")
+    return stored
+
+
+def changed_inputs(then: Mapping[str, Any], now: Mapping[str, Any]) -> str:
+    """The input files whose contents differ between two identities' ``inputs``, in words ('' if none).
+
+    >>> changed_inputs({"network.path": {"path": "a.txt", "sha256": "1f2e"}},
+    ...                {"network.path": {"path": "a.txt", "sha256": "9c3b"}})
+    "'a.txt' (network.path: SHA-256 1f2e then, 9c3b now)"
+    """
+    def sha(entry: Any) -> str:
+        return str(entry.get("sha256"))[:12] if isinstance(entry, Mapping) else "none"
+
+    differ = [what for what in sorted(set(then) | set(now)) if then.get(what) != now.get(what)]
+    return "; ".join(f"{(now.get(w) or then.get(w) or {}).get('path')!r} ({w}: SHA-256 {sha(then.get(w))} then, "
+                     f"{sha(now.get(w))} now)" for w in differ)
+
+
+def _foreign(path: Path) -> CheckpointError:
+    return CheckpointError(
+        f"The checkpoint {str(path)!r} belongs to another run (another configuration, input file or seed) than "
+        f"its folder's run.json: it is never read. Remove it, or start again with --overwrite.")
+
+
+def _recompute(path: Path, exc: CheckpointError, what: str) -> None:
+    """Remove a damaged checkpoint file, saying so: what it held is computed again, to the same bits."""
+    warnings.warn(f"{exc} It is removed; {what}.", CheckpointWarning, stacklevel=4)
+    path.unlink(missing_ok=True)
 
 
 def check_output_dir(out: Path) -> None:
     """Refuse an output directory that is an existing file (the one check every output folder shares)."""
     if out.exists() and not out.is_dir():
         raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
-
-
-def reason(exc: OSError) -> str:
-    """The OS's words for an error, without the traceback's chain."""
-    return exc.strerror or str(exc)
 
 
 # -- records <-> flat arrays ---------------------------------------------------

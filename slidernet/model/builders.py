@@ -363,6 +363,22 @@ def _nodes_file(path: Path) -> Path:
     return path.with_name(path.stem + ".nodes.csv")
 
 
+def graph_files(path: str | PathLike[str]) -> dict[str, Path]:
+    """The files :func:`read_graph` reads for ``path`` without ``positions`` (as a configuration reads it).
+
+    Returns
+    -------
+    dict of str to Path
+        ``"graph"``: the file itself; ``"nodes"``: an edge list's companion
+        node file (``<stem>.nodes.csv``), where the file is an edge list.
+    """
+    p = Path(path)
+    files = {"graph": p}
+    if p.suffix.lower() != ".graphml":
+        files["nodes"] = _nodes_file(p)
+    return files
+
+
 def read_graph(path: str | PathLike[str], positions: Any = None) -> nx.Graph:
     """Read a network file into a networkx graph that :func:`from_graph` accepts.
 
