@@ -369,3 +369,64 @@ def test_a_parameter_that_is_not_a_real_number_is_one_line_naming_it(table, body
     assert len(lines) == 1, err
     assert re.match(rf"slidernet: error: The '{re.escape(table)}' field: {match}", lines[0]), lines[0]
     assert not out.exists()
+
+
+# The configuration's own numbers follow the plugins' rule (slidernet._validation.is_real, is_integral): a
+# string or a boolean is refused by name, never read as the number it looks like. Issue 37: realizations =
+# true ran one realization and steps = "200" ran 200 steps.
+# (id, dotted key, value, the message's pattern)
+NOT_A_NUMBER = [
+    ("realizations-true", "realizations", True,
+     r"The 'realizations' field must be an integer\. Got True instead\."),
+    ("steps-text", "steps", "200", r"The 'steps' field must be an integer\. Got '200' instead\."),
+    ("steps-fraction", "steps", 1.5, r"The 'steps' field must be an integer\. Got 1\.5 instead\."),
+    ("seed-false", "seed", False, r"The 'seed' field must be an integer\. Got False instead\."),
+    ("record-time-true", "record", [0, True], r"The 'record\.1' field must be an integer\. Got True instead\."),
+    ("Ntilde-text", "network.Ntilde", "1e-7", r"The 'network\.Ntilde' field must be a real number\. Got '1e-7'"),
+    ("mu_d-true", "friction.mu_d", True, r"The 'friction\.mu_d' field must be a real number\. Got True"),
+    ("n-text", "network.n", "8", r"The 'network\.n' field must be an integer\. Got '8' instead\."),
+    ("kappa-false", "network.kappa", False, r"The 'network\.kappa' field must be a real number\. Got False"),
+    ("batch-true", "solver.batch", True, r"The 'solver\.batch' field must be an integer\. Got True instead\."),
+    ("workers-text", "execution.workers", "2", r"The 'execution\.workers' field must be an integer\. Got '2'"),
+    ("checkpoint_every-true", "execution.checkpoint_every", True,
+     r"The 'execution\.checkpoint_every' field must be a real number\. Got True instead\."),
+]
+
+
+@pytest.mark.parametrize(("key", "value", "match"), [c[1:] for c in NOT_A_NUMBER],
+                         ids=[c[0] for c in NOT_A_NUMBER])
+def test_a_number_of_the_configuration_is_never_a_string_or_a_boolean(key, value, match):
+    network = {"network.kind": "chain", "network.n": 4} if key.startswith("network.") else {}
+    with pytest.raises(ConfigError, match=match):
+        load_config(make_config(**{**network, key: value}))
+
+
+@pytest.mark.parametrize(("key", "value", "expected"),
+                         [("steps", 1e4, 10_000), ("realizations", 3.0, 3), ("seed", np.int64(7), 7),
+                          ("network.Ntilde", np.float64(1e-7), 1e-7), ("solver.max_avalanche", 1e6, 1_000_000)],
+                         ids=["steps-1e4", "realizations-3.0", "seed-numpy-int", "Ntilde-numpy",
+                              "max_avalanche-1e6"])
+def test_whole_floats_and_numpy_scalars_are_numbers(key, value, expected):
+    cfg = load_config(make_config(**{key: value}))
+    got = cfg
+    for part in key.split("."):
+        got = getattr(got, part)
+    assert got == expected and type(got) is type(expected)
+
+
+def test_a_configuration_file_that_is_not_utf8_is_one_line_naming_it(tmp_path, capsys):
+    from slidernet.cli import main
+
+    path = tmp_path / "latin1.toml"
+    path.write_bytes("# Réglage de référence\n".encode("latin-1") + REFERENCE_TOML.encode())
+    with pytest.raises(ConfigError, match=r"toml' is not UTF-8 text, as TOML must be: byte 0xe9 on line 1"):
+        load_config(path)
+    status = main(["run", str(path), "--out", str(tmp_path / "out"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert status == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_given_as_the_configuration_is_named_as_a_folder(tmp_path):
+    with pytest.raises(ConfigError, match=r"The configuration file '.*' is a folder, not a file\."):
+        load_config(tmp_path)

@@ -42,6 +42,7 @@ import networkx as nx
 import numpy as np
 import scipy.spatial
 
+from slidernet._validation import is_integral
 from slidernet.errors import ConfigError, param_error
 from slidernet.model.lattice import Lattice
 from slidernet.model.network import Network, chain
@@ -115,13 +116,6 @@ def _check_overrides(overrides: Mapping[str, Any], n_nodes: int, n_edges: int, o
                               f"an array of shape {shape}")
 
 
-def _is_integral(value: object) -> bool:
-    # Like chain(): accept 3 and 3.0 (TOML or JSON may give either) but not True.
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        return False
-    return math.isfinite(value) and int(value) == value
-
-
 def _lattice_shape(shape: object, owner: str) -> tuple[int, int]:
     """(rows, cols) as ints, or the standard ConfigError."""
     requirement = "two integers >= 1 with at least 2 nodes"
@@ -129,7 +123,7 @@ def _lattice_shape(shape: object, owner: str) -> tuple[int, int]:
         rows, cols = shape  # type: ignore[misc]
     except (TypeError, ValueError):
         raise param_error("shape", owner, requirement, shape) from None
-    if not (_is_integral(rows) and _is_integral(cols)):
+    if not (is_integral(rows) and is_integral(cols)):
         raise param_error("shape", owner, requirement, shape)
     rows, cols = int(rows), int(cols)
     if rows < 1 or cols < 1 or rows * cols < 2:
@@ -278,7 +272,7 @@ def irregular(n: int, Ntilde: float, rng: np.random.Generator, **overrides: Any)
     >>> bool((net.edges[:, 0] < net.edges[:, 1]).all())
     True
     """
-    if not _is_integral(n) or n < 3:
+    if not is_integral(n) or n < 3:
         raise param_error("n", "irregular", "an integer >= 3", n)
     if not isinstance(rng, np.random.Generator):
         raise param_error("rng", "irregular", "a numpy.random.Generator", type(rng).__name__)
@@ -751,7 +745,7 @@ def build(kind: str, params: Mapping[str, Any], Ntilde: float,
         return chain(2, Ntilde=Ntilde, **overrides)
     if kind == "chain":
         n = own["n"]
-        if not _is_integral(n) or n < 2:
+        if not is_integral(n) or n < 2:
             raise param_error("n", "chain", "an integer >= 2", n)  # chain()'s own message
         _check_overrides(overrides, int(n), int(n) - 1, "chain")
         return chain(int(n), Ntilde=Ntilde, **overrides)
