@@ -13,7 +13,8 @@ Seeds
     themselves, and a point of a sweep is the plain run of its configuration,
     bit for bit. A seed of None is resolved once (fresh entropy) and shared by
     every point. ``seed`` cannot be swept; ``realizations`` gives
-    independent samples.
+    independent samples, and cannot be swept either: every point has the
+    same number.
 Dimensions
     One per swept key, in the order given, named after the key's last
     component (``driver.sigma_theta`` -> ``sigma_theta``), or after the full
@@ -38,8 +39,7 @@ Times
     run). Any other difference in the recorded times is refused before any
     work.
 Layout
-    Every point must have the same number of realizations and the same
-    observables, and with ``mu_eff`` the same tilt test: the pair kernel's
+    Every point must have the same observables, and with ``mu_eff`` the same tilt test: the pair kernel's
     default, the appendix's test before every rearrangement, and the
     network test at the recorded times are two estimators, so a sweep that
     mixes them is refused (``mu_eff_at = "records"`` runs the network test
@@ -129,6 +129,9 @@ _UNSWEEPABLE = {
     "seed": "every point runs with the configuration's seed (common random numbers); "
             "raise 'realizations' for more independent samples",
     "execution": "the [execution] table never changes a result; pass workers= or scheduler= instead",
+    # Refused here, once and by its key, rather than as two points that cannot be stacked (issue 37).
+    "realizations": "the points are stacked along one dimension of independent samples, which has one length; "
+                    "set it once in the configuration",
 }
 
 
@@ -610,8 +613,6 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> tuple[np.
                          f"begin with those of point {shortest} (the fewest steps); to sweep 'steps', record "
                          f"'all', an explicit list of times that holds every smaller 'steps', or 'log' with "
                          f"'steps' whole decades apart")
-        if c.realizations != cfgs[0].realizations:
-            raise refuse(0, i, f"{cfgs[0].realizations} and {c.realizations} realizations")
         if set(c.observables) != set(cfgs[0].observables):
             raise refuse(0, i, f"observables {sorted(cfgs[0].observables)} and {sorted(c.observables)}")
         # What decides the kernel, the nodes and the tilt test; the scene is built once per distinct one.

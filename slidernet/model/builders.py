@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import ast
 import csv
+import io
 import math
 import numbers
 from collections.abc import Mapping, Sequence
@@ -418,8 +419,19 @@ def read_graph(path: str | PathLike[str], positions: Any = None) -> nx.Graph:
     """
     p = Path(path)
     suffix = _suffix(p, "read_graph")
+    if p.is_dir():
+        raise ConfigError(f"The network file {str(p)!r} is a folder, not a file.")
     if not p.is_file():
         raise ConfigError(f"The network file {str(p)!r} does not exist.")
+    try:
+        return _read_graph(p, suffix, positions)
+    except OSError as exc:  # no permission, ...: the reason in the system's words
+        raise ConfigError(f"The network file {str(exc.filename or p)!r} cannot be read: "
+                          f"{exc.strerror or exc}.") from None
+
+
+def _read_graph(p: Path, suffix: str, positions: Any) -> nx.Graph:
+    """:func:`read_graph` of a file that exists (the reading only)."""
     if suffix == ".graphml":
         G = _read_graphml(p)
         if positions is not None:
@@ -523,9 +535,23 @@ def _int(text: str, what: str, where: str) -> int:
         raise ConfigError(f"{where}: {what} must be an integer node id. Got {text!r} instead.") from None
 
 
+def _text(path: Path) -> io.StringIO:
+    """A network's text file (edge list, nodes file), read as UTF-8 (a byte-order mark is skipped), as a stream.
+
+    Not the locale's encoding: a file then reads the same on every machine, as the TOML file that names it.
+    """
+    data = path.read_bytes()
+    try:
+        return io.StringIO(data.decode("utf-8-sig"), newline="")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise ConfigError(f"The network file {str(path)!r} is not UTF-8 text: byte 0x{data[exc.start]:02x} on "
+                          f"line {line} cannot be decoded. Save it as UTF-8.") from None
+
+
 def _read_nodes_csv(path: Path) -> nx.Graph:
     G = nx.Graph()
-    with path.open(newline="") as f:
+    with _text(path) as f:
         reader = csv.DictReader(f)
         columns = [c.strip() for c in (reader.fieldnames or [])]
         allowed = {"node", "x", "y", "normal_load"}
@@ -570,7 +596,7 @@ def _spring_data(items: Mapping[Any, Any], where: str) -> dict[str, float]:
 
 
 def _read_edges_text(path: Path, G: nx.Graph) -> None:
-    with path.open() as f:
+    with _text(path) as f:
         for number, raw in enumerate(f, start=1):
             line = raw.split("#", 1)[0].strip()
             if not line:
@@ -600,7 +626,7 @@ def _read_edges_text(path: Path, G: nx.Graph) -> None:
 
 
 def _read_edges_csv(path: Path, G: nx.Graph) -> None:
-    with path.open(newline="") as f:
+    with _text(path) as f:
         reader = csv.DictReader(f)
         columns = [c.strip() for c in (reader.fieldnames or [])]
         ends = next((pair for pair in (("i", "j"), ("source", "target")) if set(pair) <= set(columns)), None)
@@ -664,14 +690,14 @@ def write_graph(net: Network, path: str | PathLike[str]) -> list[Path]:
         raise ConfigError(f"{str(p)!r}: an edge list cannot store the network's external forces f_ext; "
                           "write a '.graphml' file instead.")
     nodes = _nodes_file(p)
-    with nodes.open("w", newline="") as f:
+    with nodes.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["node", *axes, "normal_load"])
         # tolist() gives Python floats, whose str is the shortest exact repr.
         for v, (pos, load) in enumerate(zip(net.positions.tolist(), net.normal_load.tolist(), strict=True)):
             w.writerow([v, *pos, load])
     cols = zip(net.edges.tolist(), net.k.tolist(), net.kappa.tolist(), net.rest_length.tolist(), strict=True)
-    with p.open("w", newline="") as f:
+    with p.open("w", newline="", encoding="utf-8") as f:
         if suffix == ".csv":
             w = csv.writer(f)
             w.writerow(["i", "j", "k", "kappa", "rest_length"])
