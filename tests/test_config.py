@@ -430,3 +430,39 @@ def test_a_configuration_file_that_is_not_utf8_is_one_line_naming_it(tmp_path, c
 def test_a_folder_given_as_the_configuration_is_named_as_a_folder(tmp_path):
     with pytest.raises(ConfigError, match=r"The configuration file '.*' is a folder, not a file\."):
         load_config(tmp_path)
+
+
+# Issue 37: a Pareto law with alpha = 0.01 and mu_d = 1e308 printed raw numpy RuntimeWarning lines before the
+# error or the result (which, for the second, held inf). Every threshold must stay below MU_S_MAX; the refusal
+# is the only output, and no floating-point warning comes before it.
+# (id, [friction] table, the message's pattern)
+EXTREME_LAWS = [
+    ("pareto-alpha-0.01", {"mu_d": 0.5, "static": {"name": "pareto", "alpha": 0.01, "scale": 0.1, "loc": 0.5}},
+     r"the distribution 'pareto' \(above mu_d = 0\.5\) draws mu_s > 1e\+150 with probability 0\.0309; every "
+     r"threshold must stay below 1e\+150"),
+    ("mu_d-1e308-uniform", {"mu_d": 1e308, "static": {"name": "uniform", "low": 1e308, "high": 1.5e308}},
+     r"the distribution 'uniform' \(above mu_d = 1e\+308\) draws mu_s > 1e\+150 with probability 1;"),
+    ("mu_d-1e308-gaussian", {"mu_d": 1e308, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+     r"The 'mean' parameter of gaussian must be > mu_d = 1e\+308\. Got 0\.6 instead\."),
+    ("mu_d-1e308-pareto", {"mu_d": 1e308, "static": {"name": "pareto", "alpha": 3.0, "scale": 0.1}},
+     r"The 'loc' parameter of pareto must be such that P\(mu_s > mu_d = 1e\+308\) >= 0\.001 \(it is 0\)"),
+    ("mu_d-1e308-weibull", {"mu_d": 1e308, "static": {"name": "weibull", "shape": 2.0, "scale": 0.1}},
+     r"The 'loc' parameter of weibull must be such that P\(mu_s > mu_d = 1e\+308\) >= 0\.001"),
+]
+
+
+@pytest.mark.parametrize(("friction", "match"), [c[1:] for c in EXTREME_LAWS], ids=[c[0] for c in EXTREME_LAWS])
+def test_extreme_laws_are_refused_without_floating_point_warnings(friction, match):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a RuntimeWarning would be raised here instead of the refusal
+        with pytest.raises(ConfigError, match=rf"^The 'friction\.static' field: .*{match}"):
+            load_config(make_config(friction=friction))
+
+
+def test_a_law_just_inside_the_threshold_bound_is_accepted():
+    # alpha = 0.2: P(mu_s > 1e150) = (1e150 / 0.1)^-0.2 = 1e-30, below 2^-53.
+    cfg = load_config(make_config(friction={"mu_d": 0.5, "static": {"name": "pareto", "alpha": 0.2, "scale": 0.1,
+                                                                    "loc": 0.5}}))
+    assert cfg.distribution().sf(1e150) < 2.0**-53
