@@ -22,6 +22,7 @@ from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import CheckpointError, RunInterrupted, SlidAwayWarning, param_error
 from slidernet.io import read_result
 from slidernet.io.store import RunStore
+from slidernet.solver import budget
 from slidernet.solver.compile import compile_kernels, terminal_notice
 
 
@@ -130,6 +131,11 @@ def run(
 
     Raises
     ------
+    SizeError
+        Before any work, if the run's estimated memory exceeds the machine's
+        (:mod:`slidernet.solver.budget`).
+    PrecisionError
+        Before any work, if float64 cannot resolve the scene's slips.
     RunInterrupted
         On Ctrl-C (SIGINT) or SIGTERM: the running realizations stop at
         their next clean point, and with ``out`` the finished ones and the
@@ -141,6 +147,12 @@ def run(
     SchedulerError
         If the Dask scheduler does not answer within
         ``execution.scheduler_timeout`` seconds.
+
+    Warns
+    -----
+    SlowRunWarning
+        Once, before any work, if the run would take more than an hour at
+        the measured rates of the kernels (:mod:`slidernet.solver.budget`).
 
     Examples
     --------
@@ -169,8 +181,13 @@ def run(
     scheduler = scheduler or ex.scheduler
     timeout = float(scheduler_timeout or ex.scheduler_timeout)
     R = cfg.realizations
+    # Before the network is built (a network that cannot fit is refused before it is tried), then with
+    # the scene: float64's precision and the time the run would take. A Dask worker runs one realization
+    # at a time here, like one local worker.
+    budget.check_memory(budget.memory_estimate(cfg, 1 if scheduler else workers, streamed=out is not None))
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     scene = scene_of(config_json)  # validates the scene before any file is touched; forked workers inherit it
+    budget.check_run(cfg, scene, workers)
     store = None
     if out is not None:
         store = RunStore(out, identity(requested, cfg), resume, overwrite=overwrite)
