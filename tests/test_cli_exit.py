@@ -18,6 +18,7 @@ import pytest
 
 from slidernet import cli
 from slidernet.errors import SlowRunWarning
+from tests.test_output_folders import SMALL  # a run of two sliders, 2 realizations of 50 steps
 
 # Runs the command with a finder in front of Python's import system that sends SIGINT to this process when the
 # module named by argv[1] is about to be imported: Ctrl-C at a known point of the start-up, on any machine.
@@ -34,24 +35,6 @@ CTRL_C_AT_IMPORT = textwrap.dedent("""\
     from slidernet.cli import main
     sys.exit(main(sys.argv[2:]))
 """)
-
-SMALL = """\
-seed = 1
-realizations = 2
-steps = 50
-[network]
-kind = "two_slider"
-Ntilde = 1e-7
-[friction]
-mu_d = 0.5
-[friction.static]
-name = "gaussian"
-mean = 0.6
-std = 0.01
-[driver]
-name = "gaussian_steps"
-sigma_theta = 1e-6
-"""
 
 
 @pytest.mark.parametrize(("module", "command", "line"), [
