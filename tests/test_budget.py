@@ -23,6 +23,7 @@ import slidernet
 from slidernet import cli
 from slidernet.config import load_config
 from slidernet.ensemble import runner
+from slidernet.ensemble.sweep import sweep
 from slidernet.errors import ConfigError, PrecisionError, SizeError, SlowRunWarning
 from slidernet.solver import Scene, budget
 
@@ -98,6 +99,18 @@ def test_the_command_refuses_a_size_with_one_line_and_exit_2(machine: None, tmp_
     assert err.count("\n") == 1 and err.startswith("slidernet: error: This run needs about ")
     assert "the network of 2,000,000,000 sliders" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_refuses_a_point_that_cannot_fit_before_any_point_runs(machine: None, tmp_path: Path,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a point ran before every point's size was checked")
+
+    monkeypatch.setattr(runner, "run_in", no_run)
+    with pytest.raises(SizeError, match=r"^Sweep point 1 \(network\.n=2000000000\): This run needs about .* the "
+                                        r"network of 2,000,000,000 sliders"):
+        sweep(config(), {"network.n": [8, 2 * 10**9]}, out=tmp_path / "sweep", workers=1, progress=False)
+    assert not (tmp_path / "sweep" / "sweep.json").exists()
 
 
 def test_memory_estimate_streams_records_with_an_output_folder() -> None:

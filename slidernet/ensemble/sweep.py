@@ -111,10 +111,10 @@ from tqdm.auto import tqdm
 from slidernet._version import __version__
 from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
-from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
+from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted, SizeError
 from slidernet.io import atomic_output, write_netcdf
 from slidernet.io.store import check_output_dir
-from slidernet.solver import Scene, record_times
+from slidernet.solver import Scene, budget, record_times
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -382,6 +382,17 @@ def sweep(
     folder = None if out is None else Path(out)
     identity = _identity(base, grid)
     seed = base.get("seed")
+    keys = list(grid)
+    shape = tuple(len(v) for v in grid.values())
+    points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
+    # Every point's size before any file is touched (each point checks it again as it starts, with its
+    # workers, and then its precision and time, which need its scene); the seed does not change a size.
+    for i, assignment in enumerate(points):
+        try:
+            budget.check_memory(budget.memory_estimate(_point_config(base, assignment, i),
+                                                       streamed=folder is not None))
+        except SizeError as exc:
+            raise SizeError(f"Sweep point {i} ({_describe(assignment)}): {exc}") from None
     if folder is not None:
         if overwrite and not resume:
             _clear_folder(folder)
@@ -391,9 +402,6 @@ def sweep(
         # As runner.resolve_seed, once for the whole sweep: every point shares it.
         seed = int(np.random.SeedSequence().entropy)
     base = {**base, "seed": seed}
-    keys = list(grid)
-    shape = tuple(len(v) for v in grid.values())
-    points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
     cfgs = [_point_config(base, assignment, i) for i, assignment in enumerate(points)]
     t_common, n_nodes = _check_layout(cfgs, points)
 
