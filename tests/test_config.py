@@ -234,10 +234,11 @@ def test_refused_before_any_work(key, value, clean_registries):
     assert SpyDriver.calls == 0
     # Sanity: the same config without the bad value does run the driver (in
     # this process, where the spy counts: one worker), once per realization (the probe that compiles
-    # the kernels first runs a built-in driver in its place: slidernet.solver.compile).
+    # the kernels first runs a built-in driver in its place: slidernet.solver.compile), and once before,
+    # from a generator of its own, for the scale of theta (slidernet.solver.budget.scales).
     good = make_config(steps=10, realizations=2, observables=["n"], **{"driver.name": "spy"})
     slidernet.run(good, workers=1)
-    assert SpyDriver.calls == 2
+    assert SpyDriver.calls == 1 + 2
 
 
 def test_defaults_are_filled_in():
