@@ -3,6 +3,8 @@
 This module sits below everything else, so that the plugins, the model, the
 theory and the solver can all check values without importing one another:
 
+- :func:`is_real` and :func:`is_integral`: the rule itself, for a real
+  number and for a whole one (the configuration's number types use it too);
 - :func:`check_scalar`: one real parameter (a plugin's, a material value);
 - :func:`check_array`: a real parameter that may be an array (the theory's
   vectorised functions);
@@ -11,7 +13,9 @@ theory and the solver can all check values without importing one another:
 One rule for every parameter: a real number is an ``int`` or a ``float``
 (any :class:`numbers.Real`, numpy's scalars included), never a ``bool`` and
 never a string, even one that reads as a number (``"0.1"`` in a TOML file is
-a typo to report, not a value to guess).
+a typo to report, not a value to guess). A whole number (a count, a size, a
+seed) is a real number with no fractional part: ``3`` and ``3.0`` (TOML and
+JSON may give either; ``1e4`` is a float in TOML), never ``True`` or ``"3"``.
 """
 
 from __future__ import annotations
@@ -35,6 +39,24 @@ _TESTS: dict[str, Callable[[Any], Any]] = {
     ">= 1": lambda x: x >= 1,
     "> 1": lambda x: x > 1,
 }
+
+
+def is_real(value: object) -> bool:
+    """True for a real number: an int or a float (numpy's too), never a bool or a string.
+
+    >>> is_real(0.1), is_real(2), is_real(True), is_real("0.1")
+    (True, True, False, False)
+    """
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, numbers.Real)
+
+
+def is_integral(value: object) -> bool:
+    """True for a finite real number with no fractional part (``3``, ``3.0``, ``1e4``); never a bool or a string.
+
+    >>> is_integral(3), is_integral(1e4), is_integral(2.5), is_integral(True), is_integral("3")
+    (True, True, False, False, False)
+    """
+    return is_real(value) and math.isfinite(value) and int(value) == value
 
 
 def _requirement(requirement: str) -> Callable[[Any], Any]:
@@ -80,7 +102,7 @@ def check_scalar(value: object, param: str, owner: str, requirement: str = "fini
     slidernet.errors.ConfigError: The 'mean' parameter of gaussian must be finite. Got inf instead.
     """
     test = _requirement(requirement)
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not is_real(value):
         kind = "a real number" if requirement == "finite" else f"a real number {requirement}"
         raise param_error(param, owner, kind, value)
     x = float(value)

@@ -14,23 +14,42 @@
                                           Ntilde, sigma_theta and tau_th of a physical setup
 
 ``python -m slidernet ...`` runs the same command.
+
+Exit status, one rule for every subcommand:
+
+- 0: done;
+- 2: refused or failed because of something the user can change: the
+  configuration, an argument, a file or a folder (missing, a folder where a
+  file is wanted, unreadable, not UTF-8, no permission, a full disk), the
+  machine's memory, a scheduler that does not answer. One line on stderr,
+  ``slidernet: error: ...``, says what and where, and nothing half-written
+  is left behind;
+- 1: a bug of slidernet's, an error nobody foresaw: Python's traceback, then
+  one line asking to report it;
+- 128 + the signal's number: stopped by a signal, as a shell reports it (130
+  for Ctrl-C, also while the command starts; 143 for SIGTERM; 141 for an
+  output pipe closed early, SIGPIPE).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
+import signal
 import sys
+import traceback
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 from slidernet.errors import (
     CheckpointWarning,
     RunInterrupted,
     SlidAwayWarning,
     SlidernetError,
+    SlowRunWarning,
     UnknownPluginError,
 )
 
@@ -319,51 +338,88 @@ def _cmd_units(args: argparse.Namespace) -> int:
     return 0
 
 
-def _one_line_warnings(show: Callable[..., None]) -> Callable[..., None]:
-    """``warnings.showwarning`` that shows a :class:`~slidernet.errors.CheckpointWarning` as one line on
-    stderr, and any other warning as ``show`` does."""
-
-    def showwarning(message, category, filename, lineno, file=None, line=None) -> None:
-        if issubclass(category, CheckpointWarning):
-            print(f"slidernet: warning: {message}", file=sys.stderr if file is None else file, flush=True)
-        else:
-            show(message, category, filename, lineno, file, line)
-
-    return showwarning
+#: The exit status of the command, one rule for every subcommand (docs/getting-started.md says it too).
+EXIT_OK = 0
+#: A bug of slidernet's: an error nobody foresaw. Python's traceback is shown, to be reported.
+EXIT_BUG = 1
+#: Refused or failed because of something the user can change: the configuration, a file or a folder (missing,
+#: unreadable, not UTF-8, no permission, a full disk), an argument, the machine's memory, a scheduler that does
+#: not answer. One line on stderr says what and where; nothing half-written is left behind.
+EXIT_INPUT = 2
+#: Stopped by a signal: 128 + its number, as a shell reports it (130 for Ctrl-C, 143 for SIGTERM, 141 for a
+#: closed output pipe, SIGPIPE).
+EXIT_SIGNAL = 128
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``slidernet`` command; returns the exit status."""
-    args = _parser().parse_args(argv)
-    commands = {"run": _cmd_run, "plot": _cmd_plot, "paper": _cmd_paper, "bench": _cmd_bench, "sweep": _cmd_sweep,
-                "plugins": _cmd_plugins,
-                "units": _cmd_units}
+    """Entry point of the ``slidernet`` command; returns the exit status (:data:`EXIT_INPUT` and the others).
+
+    Everything runs inside the handlers below, the parser and the imports of
+    numpy, numba and xarray included, so that Ctrl-C while the command
+    starts is one line and exit 130, as it is later.
+    """
+    started = False
     try:
-        with warnings.catch_warnings():
-            warnings.showwarning = _one_line_warnings(warnings.showwarning)
+        with _one_line_warnings():
+            args = _parser().parse_args(argv)
+            commands = {"run": _cmd_run, "plot": _cmd_plot, "paper": _cmd_paper, "bench": _cmd_bench,
+                        "sweep": _cmd_sweep, "plugins": _cmd_plugins, "units": _cmd_units}
+            started = True
             status = commands[args.command](args)
-        sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit
-        return status
+            sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit
+            return status
     except SlidernetError as exc:
         print(f"slidernet: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_INPUT
     except RunInterrupted as exc:
         print(f"slidernet: {exc}", file=sys.stderr)
-        return 128 + exc.signum
+        return EXIT_SIGNAL + exc.signum
     except KeyboardInterrupt:
-        print("slidernet: interrupted; files already written are complete, nothing else was saved.",
-              file=sys.stderr)
-        return 130
+        if not started:
+            print("slidernet: interrupted while starting; nothing was done.", file=sys.stderr)
+        else:
+            print("slidernet: interrupted; files already written are complete, nothing else was saved.",
+                  file=sys.stderr)
+        return EXIT_SIGNAL + signal.SIGINT
     except BrokenPipeError:
         # The reader went away (`slidernet units ... | head`): say so once, on stderr, and make
         # the interpreter's own flush of stdout at exit write nowhere instead of raising again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         print("slidernet: error: the output pipe was closed before everything was written.", file=sys.stderr)
-        return 1
-    except OSError as exc:
+        return EXIT_SIGNAL + signal.SIGPIPE
+    except OSError as exc:  # a file or a folder of the user's: the same status as any other input
         where = f" {exc.filename!r}:" if exc.filename else ""
         print(f"slidernet: error:{where} {exc.strerror or exc}", file=sys.stderr)
-        return 1
+        return EXIT_INPUT
+    except MemoryError as exc:  # the estimate (slidernet.solver.budget) passed, the machine had less free
+        detail = f" ({exc})" if str(exc) else ""
+        print(f"slidernet: error: out of memory{detail}: the run needs more memory than this machine had free; "
+              "run fewer workers or a smaller configuration.", file=sys.stderr)
+        return EXIT_INPUT
+    except Exception:
+        traceback.print_exc()
+        print("slidernet: internal error: this is a bug of slidernet; please report it with the lines above.",
+              file=sys.stderr)
+        return EXIT_BUG
+
+
+@contextlib.contextmanager
+def _one_line_warnings() -> Iterator[None]:
+    """slidernet's warnings as one line on stderr (``slidernet: warning: ...``); others as Python shows them."""
+    shown = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: TextIO | None = None, line: str | None = None) -> None:
+        if issubclass(category, (SlowRunWarning, SlidAwayWarning, CheckpointWarning)):
+            print(f"slidernet: warning: {message}", file=sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -19,6 +19,17 @@ class UnknownPluginError(ConfigError):
     """A distribution or driver name is not registered."""
 
 
+class SizeError(ConfigError):
+    """A run would need more memory than the machine has (its estimate, from the configuration, exceeds
+    the machine's memory); raised before any work, with the estimate and the machine's memory."""
+
+
+class PrecisionError(ConfigError):
+    """float64 cannot resolve the slips of a scene: its forces are sums of terms so large that their
+    rounding reaches the gap between the static and the dynamic thresholds; raised before any work,
+    naming the parameter that makes the terms large (or the gap small)."""
+
+
 class PluginError(SlidernetError, RuntimeError):
     """A plugin returned values that break the model's contract (NaN, mu_s <= mu_d, ...)."""
 
@@ -92,6 +103,11 @@ class CheckpointWarning(UserWarning):
 
 class SlidAwayWarning(UserWarning):
     """Every realization of a run slid away down its incline (its ``slid_away_at`` is finite)."""
+
+
+class SlowRunWarning(UserWarning):
+    """A run would take hours: its estimated slips, at a stated rate of slips per second, exceed the
+    threshold of :mod:`slidernet.solver.budget`; raised once, before the run, with the estimate."""
 
 
 def param_error(param: str, owner: str, requirement: str, got: object) -> ConfigError:

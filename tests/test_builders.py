@@ -448,11 +448,23 @@ def test_overrides_replace_file_values(tmp_path):
                  "needs the header i,j (or source,target)", id="bad-csv-header"),
     pytest.param("net.txt", {"net.txt": "0 1\n", "net.nodes.csv": "id,x\n0,0\n1,1\n"},
                  "needs the header node,x[,y][,normal_load]", id="bad-nodes-header"),
+    # Issue 37: a folder was "a network file that does not exist"; a Latin-1 file a UnicodeDecodeError.
+    pytest.param("net.graphml", {"net.graphml": "folder"}, "is a folder, not a file.", id="a-folder"),
+    pytest.param("net.txt", {"net.txt": "# r\xe9seau\n0 1\n".encode("latin-1"),
+                             "net.nodes.csv": "node,x\n0,0\n1,1\n"},
+                 "net.txt' is not UTF-8 text: byte 0xe9 on line 1 cannot be decoded. Save it as UTF-8.",
+                 id="edge-list-not-utf8"),
+    pytest.param("net.txt", {"net.txt": "0 1\n", "net.nodes.csv": "node,x\n0,0\n\xe91,1\n".encode("latin-1")},
+                 "net.nodes.csv' is not UTF-8 text: byte 0xe9 on line 3", id="nodes-file-not-utf8"),
 ])
 def test_read_graph_errors(tmp_path, name, files, message):
     for fname, text in files.items():
         if text is None:  # a GraphML file whose nodes have no positions
             nx.write_graphml(nx.path_graph(3), tmp_path / fname)
+        elif text == "folder":
+            (tmp_path / fname).mkdir()
+        elif isinstance(text, bytes):
+            (tmp_path / fname).write_bytes(text)
         else:
             (tmp_path / fname).write_text(text)
     with pytest.raises(ConfigError, match=re.escape(message)):

@@ -234,10 +234,11 @@ def test_refused_before_any_work(key, value, clean_registries):
     assert SpyDriver.calls == 0
     # Sanity: the same config without the bad value does run the driver (in
     # this process, where the spy counts: one worker), once per realization (the probe that compiles
-    # the kernels first runs a built-in driver in its place: slidernet.solver.compile).
+    # the kernels first runs a built-in driver in its place: slidernet.solver.compile), and once before,
+    # from a generator of its own, for the scale of theta (slidernet.solver.budget.scales).
     good = make_config(steps=10, realizations=2, observables=["n"], **{"driver.name": "spy"})
     slidernet.run(good, workers=1)
-    assert SpyDriver.calls == 2
+    assert SpyDriver.calls == 1 + 2
 
 
 def test_defaults_are_filled_in():
@@ -369,3 +370,100 @@ def test_a_parameter_that_is_not_a_real_number_is_one_line_naming_it(table, body
     assert len(lines) == 1, err
     assert re.match(rf"slidernet: error: The '{re.escape(table)}' field: {match}", lines[0]), lines[0]
     assert not out.exists()
+
+
+# The configuration's own numbers follow the plugins' rule (slidernet._validation.is_real, is_integral): a
+# string or a boolean is refused by name, never read as the number it looks like. Issue 37: realizations =
+# true ran one realization and steps = "200" ran 200 steps.
+# (id, dotted key, value, the message's pattern)
+NOT_A_NUMBER = [
+    ("realizations-true", "realizations", True,
+     r"The 'realizations' field must be an integer\. Got True instead\."),
+    ("steps-text", "steps", "200", r"The 'steps' field must be an integer\. Got '200' instead\."),
+    ("steps-fraction", "steps", 1.5, r"The 'steps' field must be an integer\. Got 1\.5 instead\."),
+    ("seed-false", "seed", False, r"The 'seed' field must be an integer\. Got False instead\."),
+    ("record-time-true", "record", [0, True], r"The 'record\.1' field must be an integer\. Got True instead\."),
+    ("Ntilde-text", "network.Ntilde", "1e-7", r"The 'network\.Ntilde' field must be a real number\. Got '1e-7'"),
+    ("mu_d-true", "friction.mu_d", True, r"The 'friction\.mu_d' field must be a real number\. Got True"),
+    ("n-text", "network.n", "8", r"The 'network\.n' field must be an integer\. Got '8' instead\."),
+    ("kappa-false", "network.kappa", False, r"The 'network\.kappa' field must be a real number\. Got False"),
+    ("batch-true", "solver.batch", True, r"The 'solver\.batch' field must be an integer\. Got True instead\."),
+    ("workers-text", "execution.workers", "2", r"The 'execution\.workers' field must be an integer\. Got '2'"),
+    ("checkpoint_every-true", "execution.checkpoint_every", True,
+     r"The 'execution\.checkpoint_every' field must be a real number\. Got True instead\."),
+]
+
+
+@pytest.mark.parametrize(("key", "value", "match"), [c[1:] for c in NOT_A_NUMBER],
+                         ids=[c[0] for c in NOT_A_NUMBER])
+def test_a_number_of_the_configuration_is_never_a_string_or_a_boolean(key, value, match):
+    network = {"network.kind": "chain", "network.n": 4} if key.startswith("network.") else {}
+    with pytest.raises(ConfigError, match=match):
+        load_config(make_config(**{**network, key: value}))
+
+
+@pytest.mark.parametrize(("key", "value", "expected"),
+                         [("steps", 1e4, 10_000), ("realizations", 3.0, 3), ("seed", np.int64(7), 7),
+                          ("network.Ntilde", np.float64(1e-7), 1e-7), ("solver.max_avalanche", 1e6, 1_000_000)],
+                         ids=["steps-1e4", "realizations-3.0", "seed-numpy-int", "Ntilde-numpy",
+                              "max_avalanche-1e6"])
+def test_whole_floats_and_numpy_scalars_are_numbers(key, value, expected):
+    cfg = load_config(make_config(**{key: value}))
+    got = cfg
+    for part in key.split("."):
+        got = getattr(got, part)
+    assert got == expected and type(got) is type(expected)
+
+
+def test_a_configuration_file_that_is_not_utf8_is_one_line_naming_it(tmp_path, capsys):
+    from slidernet.cli import main
+
+    path = tmp_path / "latin1.toml"
+    path.write_bytes("# Réglage de référence\n".encode("latin-1") + REFERENCE_TOML.encode())
+    with pytest.raises(ConfigError, match=r"toml' is not UTF-8 text, as TOML must be: byte 0xe9 on line 1"):
+        load_config(path)
+    status = main(["run", str(path), "--out", str(tmp_path / "out"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert status == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_given_as_the_configuration_is_named_as_a_folder(tmp_path):
+    with pytest.raises(ConfigError, match=r"The configuration file '.*' is a folder, not a file\."):
+        load_config(tmp_path)
+
+
+# Issue 37: a Pareto law with alpha = 0.01 and mu_d = 1e308 printed raw numpy RuntimeWarning lines before the
+# error or the result (which, for the second, held inf). Every threshold must stay below MU_S_MAX; the refusal
+# is the only output, and no floating-point warning comes before it.
+# (id, [friction] table, the message's pattern)
+EXTREME_LAWS = [
+    ("pareto-alpha-0.01", {"mu_d": 0.5, "static": {"name": "pareto", "alpha": 0.01, "scale": 0.1, "loc": 0.5}},
+     r"the distribution 'pareto' \(above mu_d = 0\.5\) draws mu_s > 1e\+150 with probability 0\.0309; every "
+     r"threshold must stay below 1e\+150"),
+    ("mu_d-1e308-uniform", {"mu_d": 1e308, "static": {"name": "uniform", "low": 1e308, "high": 1.5e308}},
+     r"the distribution 'uniform' \(above mu_d = 1e\+308\) draws mu_s > 1e\+150 with probability 1;"),
+    ("mu_d-1e308-gaussian", {"mu_d": 1e308, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+     r"The 'mean' parameter of gaussian must be > mu_d = 1e\+308\. Got 0\.6 instead\."),
+    ("mu_d-1e308-pareto", {"mu_d": 1e308, "static": {"name": "pareto", "alpha": 3.0, "scale": 0.1}},
+     r"The 'loc' parameter of pareto must be such that P\(mu_s > mu_d = 1e\+308\) >= 0\.001 \(it is 0\)"),
+    ("mu_d-1e308-weibull", {"mu_d": 1e308, "static": {"name": "weibull", "shape": 2.0, "scale": 0.1}},
+     r"The 'loc' parameter of weibull must be such that P\(mu_s > mu_d = 1e\+308\) >= 0\.001"),
+]
+
+
+@pytest.mark.parametrize(("friction", "match"), [c[1:] for c in EXTREME_LAWS], ids=[c[0] for c in EXTREME_LAWS])
+def test_extreme_laws_are_refused_without_floating_point_warnings(friction, match):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a RuntimeWarning would be raised here instead of the refusal
+        with pytest.raises(ConfigError, match=rf"^The 'friction\.static' field: .*{match}"):
+            load_config(make_config(friction=friction))
+
+
+def test_a_law_just_inside_the_threshold_bound_is_accepted():
+    # alpha = 0.2: P(mu_s > 1e150) = (1e150 / 0.1)^-0.2 = 1e-30, below 2^-53.
+    cfg = load_config(make_config(friction={"mu_d": 0.5, "static": {"name": "pareto", "alpha": 0.2, "scale": 0.1,
+                                                                    "loc": 0.5}}))
+    assert cfg.distribution().sf(1e150) < 2.0**-53

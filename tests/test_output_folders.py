@@ -78,11 +78,12 @@ class _Broken:
     def sample(self, rng, size):
         raise PluginError("broken on purpose")
 
+    # All of its mass between mu_d = 0.5 and 1 (a law above 1e150 is refused as the config is loaded).
     def cdf(self, x):
-        return 0.0 * x + 1.0
+        return 1.0 - self.sf(x)
 
     def sf(self, x):
-        return 1.0 + 0.0 * x
+        return (np.asarray(x, dtype=float) < 1.0) * 1.0
 
 
 @pytest.mark.parametrize("existing", [False, True], ids=["new-folder", "folder-with-files"])

@@ -87,8 +87,13 @@ def test_parse_set_reads_toml_values(text, key, values):
     ("friction.mu_d=0.5,5e-1", "lists the value 0.5 twice"),
     ("seed=1,2", "'seed' cannot be swept: .*realizations"),
     ("execution.workers=1,2", "'execution.workers' cannot be swept: .*workers="),
+    # Once, by its key (issue 37: "Sweep points 0 (realizations=2) and 1 (realizations=3) cannot be stacked:
+    # 2 and 3 realizations" named it thrice).
+    ("realizations=2,3", r"^The sweep key 'realizations' cannot be swept: the points are stacked along one "
+                         r"dimension of independent samples, which has one length; set it once in the "
+                         r"configuration\.$"),
 ], ids=["no-equals", "no-value", "empty-middle", "trailing-comma", "no-key", "bad-key", "open-bracket",
-        "open-quote", "bad-toml", "repeated-value", "repeated-float", "seed", "execution"])
+        "open-quote", "bad-toml", "repeated-value", "repeated-float", "seed", "execution", "realizations"])
 def test_parse_set_errors(text, match):
     with pytest.raises(ConfigError, match=match):
         parse_set(text)
@@ -217,7 +222,7 @@ def no_work(monkeypatch):
     (BASE, {"friction.mu_d": [0.5], "network.kind": ["two_slider", "triangle"]},
      r"(?s)Sweep point 1 \(friction.mu_d=0.5, network.kind='triangle'\): .*'network.kind'"),
     (BASE, {"steps": [50, 200]}, r"Sweep points 0 \(steps=50\) and 1 \(steps=200\) cannot be stacked: .*times"),
-    (BASE, {"realizations": [2, 3]}, "2 and 3 realizations"),
+    (BASE, {"realizations": [2, 3]}, "'realizations' cannot be swept"),
     (BASE, {"observables": [["n"], ["n", "x_G"]]}, "observables"),
     (with_values(BASE, observables=["n", "mu_eff"], network={"kind": "chain", "n": 2, "Ntilde": 1e-7}),
      {"network.n": [2, 4]},

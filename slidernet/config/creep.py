@@ -7,11 +7,9 @@ the table without the observable.
 
 from __future__ import annotations
 
-from typing import Annotated
-
 from pydantic import Field
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import NonNegativeFloat, PositiveFloat, _Strict
 
 
 class CreepConfig(_Strict):
@@ -31,7 +29,7 @@ class CreepConfig(_Strict):
     only with the observable ``"events"``).
     """
 
-    transient: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    transient: NonNegativeFloat = Field(
         0.0, description="Time, in tau_th, before which x_G is left out of the reptation velocity: v_creep "
                          "is measured from the first cycle that starts at or after it (periodic driver) or "
                          "from it (otherwise) to the end; >= 0 and < steps.")

@@ -11,7 +11,7 @@ from typing import Annotated
 
 from pydantic import Field, field_validator
 
-from slidernet.config.base import _Strict
+from slidernet.config.base import Integer, PositiveReal, _Strict
 
 _SCHEDULER_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
 
@@ -31,14 +31,14 @@ class ExecutionConfig(_Strict):
     (a run may resume with other workers).
     """
 
-    workers: Annotated[int, Field(ge=1)] | None = Field(
+    workers: Annotated[Integer, Field(ge=1)] | None = Field(
         None, description="Local processes that run the realizations (None: every core this process may use).")
     scheduler: str | None = Field(
         None, description="Address of a Dask scheduler, 'tcp://host:port'; when given, the realizations run "
                           "on that cluster and 'workers' is ignored.")
-    checkpoint_every: Annotated[float, Field(gt=0)] = Field(
+    checkpoint_every: PositiveReal = Field(
         60.0, description="Seconds between two saves of the work of a run that has an output directory.")
-    scheduler_timeout: Annotated[float, Field(gt=0)] = Field(
+    scheduler_timeout: PositiveReal = Field(
         10.0, description="Seconds to wait for the Dask scheduler to answer before giving up.")
 
     @field_validator("scheduler")

@@ -19,6 +19,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from slidernet.config.base import NOT_INTEGER, NOT_REAL
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
 from slidernet.model.builders import graph_files
@@ -52,6 +53,8 @@ def _describe(err: Mapping[str, Any]) -> str:
         return f"The {loc!r} field must be {bounds[kind]} {limit}. Got {got!r} instead."
     if kind == "finite_number":
         return f"The {loc!r} field must be a finite number. Got {got!r} instead."
+    if kind in (NOT_INTEGER, NOT_REAL):  # the rule of slidernet._validation: never a string or a boolean
+        return f"The {loc!r} field {err['msg']}. Got {got!r} instead."
     if kind == "value_error":
         msg = str(ctx.get("error", err["msg"]))
         return f"The {loc!r} field: {msg}." if loc else f"Invalid combination: {msg}."
@@ -67,13 +70,24 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     starts elsewhere (Dask) imports the same file.
     """
     path = Path(path)
+    where = f"The configuration file {str(path)!r}"
+    if path.is_dir():
+        raise ConfigError(f"{where} is a folder, not a file.")
     try:
         with path.open("rb") as fh:
             source = tomllib.load(fh)
     except FileNotFoundError:
-        raise ConfigError(f"The configuration file {str(path)!r} does not exist.") from None
+        raise ConfigError(f"{where} does not exist.") from None
+    except OSError as exc:  # no permission, a device, ...: the reason in the system's words
+        raise ConfigError(f"{where} cannot be read: {exc.strerror or exc}.") from None
+    except UnicodeDecodeError as exc:  # TOML is UTF-8 (a file saved as Latin-1 or UTF-16 fails here)
+        line = exc.object[: exc.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{where} is not UTF-8 text, as TOML must be: byte 0x{exc.object[exc.start]:02x} on line {line} "
+            f"cannot be decoded. Save it as UTF-8."
+        ) from None
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"The configuration file {str(path)!r} is not valid TOML: {exc}") from None
+        raise ConfigError(f"{where} is not valid TOML: {exc}") from None
     for table in _path_tables(source).values():
         named = Path(table["path"])
         if not named.is_absolute():

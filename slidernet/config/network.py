@@ -14,7 +14,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, _Strict
 from slidernet.errors import SlidernetError
 from slidernet.model.builders import KIND_DIMS, build
 from slidernet.model.network import Network, pair_tilt_applies
@@ -53,19 +53,19 @@ class NetworkConfig(_Strict):
     Ntilde: PositiveFloat = Field(
         description="Ntilde = N / (k l0), the one dimensionless number of the model (docs/model.md section 1); "
                     "may come from [units] instead.")
-    n: Annotated[int, Field(ge=2)] | None = Field(
+    n: Annotated[Integer, Field(ge=2)] | None = Field(
         None, description="Number of sliders: kinds 'chain' and 'irregular' (and 2 for 'two_slider').")
-    shape: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = Field(
+    shape: tuple[Annotated[Integer, Field(ge=1)], Annotated[Integer, Field(ge=1)]] | None = Field(
         None, description="[rows, cols] of a 'square' or 'triangular' lattice (at least 2 sliders).")
     path: str | None = Field(
         None, description="A GraphML or edge-list file of kind 'graph'; relative to the TOML file that names it.")
-    seed: Annotated[int, Field(ge=0)] | None = Field(
+    seed: Annotated[Integer, Field(ge=0)] | None = Field(
         None, description="Seed of an 'irregular' network's random points (None: 0); the geometry is the "
                           "same for every realization, whatever the run's seed.")
     k: PositiveFloat | None = Field(
         None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0), the paper's spring "
                           "(None: 1); k / Ntilde in N/l0 (docs/model.md section 2).")
-    kappa: Annotated[float, Field(allow_inf_nan=False)] | None = Field(
+    kappa: FiniteFloat | None = Field(
         None, description="Dilation coefficient of every spring: its rest length is its length at theta = 0 "
                           "times (1 + kappa theta) (None: 1).")
     normal_load: PositiveFloat | None = Field(

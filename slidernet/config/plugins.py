@@ -14,6 +14,7 @@ import inspect
 import math
 from typing import Annotated, Any, ClassVar
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from slidernet.config.base import PositiveFloat, _Strict
@@ -93,19 +94,40 @@ def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
         raise ConfigError(f"The '{field}' field: {exc}") from None
 
 
+#: The largest static threshold slidernet accepts, in units of the normal load: forces, the tilt tests' loads
+#: and their squares (in the tilt tests' sums and the standard errors) stay finite in float64 below it.
+MU_S_MAX = 1e150
+#: The probability above :data:`MU_S_MAX` that counts as none: below float64's resolution of a probability.
+MU_S_MAX_TAIL = 2.0**-53
+
+
 def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
-    """Build the mu_s plugin and truncate it below mu_d (docs/model.md section 1)."""
-    dist = _build_plugin(registry.distributions, friction.static, "friction.static")
-    check = getattr(dist, "check_mu_d", None)
-    if check is not None:
+    """Build the mu_s plugin and truncate it below mu_d (docs/model.md section 1).
+
+    A law that would draw thresholds above :data:`MU_S_MAX` (a power law of
+    tiny ``alpha``, mu_d = 1e308) is refused, by the law's name. Floating
+    point warnings of the law's functions at such extremes (an overflow of
+    sf(1e308)) are not shown: the values they give are judged here, and a
+    raw numpy line before the refusal said nothing more.
+    """
+    name = friction.static.name
+    with np.errstate(all="ignore"):
+        dist = _build_plugin(registry.distributions, friction.static, "friction.static")
+        check = getattr(dist, "check_mu_d", None)
         try:
-            check(friction.mu_d)
+            if check is not None:
+                check(friction.mu_d)
+            law = TruncatedBelow(dist, friction.mu_d, name)
         except ConfigError as exc:
             raise ConfigError(f"The 'friction.static' field: {exc}") from None
-    try:
-        return TruncatedBelow(dist, friction.mu_d, friction.static.name)
-    except ConfigError as exc:
-        raise ConfigError(f"The 'friction.static' field: {exc}") from None
+        tail = float(law.sf(MU_S_MAX))
+    if tail > MU_S_MAX_TAIL:  # NaN (a plugin's sf undefined there) is left to the draws' own checks
+        raise ConfigError(
+            f"The 'friction.static' field: the distribution {name!r} (above mu_d = {friction.mu_d!r}) draws "
+            f"mu_s > {MU_S_MAX:g} with probability {tail:.3g}; every threshold must stay below {MU_S_MAX:g} "
+            f"(a probability under 2^-53), so that the forces and their squares stay finite in float64."
+        )
+    return law
 
 
 def _takes_sigma_theta(name: object) -> bool | None:

@@ -13,7 +13,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from slidernet.config.base import _Strict
+from slidernet.config.base import Integer, _Strict
 from slidernet.config.creep import CreepConfig
 from slidernet.config.execution import ExecutionConfig
 from slidernet.config.network import NetworkConfig
@@ -60,16 +60,16 @@ class Config(_Strict):
     # stored results and interrupted runs (run.json) still match it.
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
 
-    seed: Annotated[int, Field(ge=0)] | None = Field(
+    seed: Annotated[Integer, Field(ge=0)] | None = Field(
         None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
                           "(None: fresh OS entropy, stored in the result).")
-    realizations: Annotated[int, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
-    steps: Annotated[int, Field(ge=1)] = Field(
+    realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
+    steps: Annotated[Integer, Field(ge=1)] = Field(
         description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")
-    record: Literal["log", "all"] | list[Annotated[int, Field(ge=0)]] = Field(
+    record: Literal["log", "all"] | list[Annotated[Integer, Field(ge=0)]] = Field(
         "log", description="Recorded times, in tau_th: 'log'-spaced, 'all', or a list of steps; 0 and 'steps' "
                            "always included.")
-    log_points_per_decade: Annotated[int, Field(ge=1, le=1000)] = Field(
+    log_points_per_decade: Annotated[Integer, Field(ge=1, le=1000)] = Field(
         20, description="Recorded times per decade of t with record = 'log'.")
     observables: list[Observable] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"],

@@ -11,7 +11,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from slidernet.config.base import _Strict
+from slidernet.config.base import Integer, _Strict
 
 
 class SolverConfig(_Strict):
@@ -30,14 +30,14 @@ class SolverConfig(_Strict):
 
     kernel: Literal["auto", "pair", "csr", "vec"] = Field(
         "auto", description="The compiled kernel: 'auto' picks the one the scene needs.")
-    max_avalanche: Annotated[int, Field(ge=1)] = Field(
+    max_avalanche: Annotated[Integer, Field(ge=1)] = Field(
         100_000_000, description="Slips after which an avalanche that has not ended stops the run with an "
                                  "AvalancheError.")
-    batch: Annotated[int, Field(ge=1)] = Field(
+    batch: Annotated[Integer, Field(ge=1)] = Field(
         1 << 16, description="Random draws that wait in the kernels' buffers; never changes a result.")
-    recompute_every: Annotated[int, Field(ge=0)] = Field(
+    recompute_every: Annotated[Integer, Field(ge=0)] = Field(
         10_000_000, description="Slips between two resets of the forces from the displacements (0: never).")
     slip: Literal["straight", "exact"] = Field(
         "straight", description="2D slips: along the force in a straight line, or integrated exactly.")
-    max_events: Annotated[int, Field(ge=1)] = Field(
+    max_events: Annotated[Integer, Field(ge=1)] = Field(
         10_000_000, description="Rows of the event catalogue (observable 'events') kept per realization.")

@@ -31,6 +31,7 @@ from slidernet.errors import (
 from slidernet.io import read_result
 from slidernet.io.netcdf import open_result
 from slidernet.io.store import RunStore, changed_inputs, file_digest
+from slidernet.solver import budget
 from slidernet.solver.compile import compile_kernels, terminal_notice
 
 
@@ -151,6 +152,11 @@ def run(
 
     Raises
     ------
+    SizeError
+        Before any work, if the run's estimated memory exceeds the machine's
+        (:mod:`slidernet.solver.budget`).
+    PrecisionError
+        Before any work, if float64 cannot resolve the scene's slips.
     RunInterrupted
         On Ctrl-C (SIGINT) or SIGTERM: the running realizations stop at
         their next clean point, and with ``out`` the finished ones and the
@@ -162,6 +168,12 @@ def run(
     SchedulerError
         If the Dask scheduler does not answer within
         ``execution.scheduler_timeout`` seconds.
+
+    Warns
+    -----
+    SlowRunWarning
+        Once, before any work, if the run would take more than an hour at
+        the measured rates of the kernels (:mod:`slidernet.solver.budget`).
 
     Examples
     --------
@@ -190,8 +202,13 @@ def run(
     scheduler = scheduler or ex.scheduler
     timeout = float(scheduler_timeout or ex.scheduler_timeout)
     R = cfg.realizations
+    # Before the network is built (a network that cannot fit is refused before it is tried), then with
+    # the scene: float64's precision and the time the run would take. A Dask worker runs one realization
+    # at a time here, like one local worker.
+    budget.check_memory(budget.memory_estimate(cfg, 1 if scheduler else workers, streamed=out is not None))
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     scene = scene_of(config_json)  # validates the scene before any file is touched; forked workers inherit it
+    budget.check_run(cfg, scene, workers)
     run_identity = identity(requested, cfg)
     store = None
     if out is not None:

@@ -13,7 +13,8 @@ Seeds
     themselves, and a point of a sweep is the plain run of its configuration,
     bit for bit. A seed of None is resolved once (fresh entropy) and shared by
     every point. ``seed`` cannot be swept; ``realizations`` gives
-    independent samples.
+    independent samples, and cannot be swept either: every point has the
+    same number.
 Dimensions
     One per swept key, in the order given, named after the key's last
     component (``driver.sigma_theta`` -> ``sigma_theta``), or after the full
@@ -38,8 +39,7 @@ Times
     run). Any other difference in the recorded times is refused before any
     work.
 Layout
-    Every point must have the same number of realizations and the same
-    observables, and with ``mu_eff`` the same tilt test: the pair kernel's
+    Every point must have the same observables, and with ``mu_eff`` the same tilt test: the pair kernel's
     default, the appendix's test before every rearrangement, and the
     network test at the recorded times are two estimators, so a sweep that
     mixes them is refused (``mu_eff_at = "records"`` runs the network test
@@ -111,10 +111,10 @@ from tqdm.auto import tqdm
 from slidernet._version import __version__
 from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
-from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted
+from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted, SizeError
 from slidernet.io import atomic_output, write_netcdf
 from slidernet.io.store import check_output_dir, locked_folder, read_identity_file
-from slidernet.solver import Scene, record_times
+from slidernet.solver import Scene, budget, record_times
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -129,6 +129,9 @@ _UNSWEEPABLE = {
     "seed": "every point runs with the configuration's seed (common random numbers); "
             "raise 'realizations' for more independent samples",
     "execution": "the [execution] table never changes a result; pass workers= or scheduler= instead",
+    # Refused here, once and by its key, rather than as two points that cannot be stacked (issue 37).
+    "realizations": "the points are stacked along one dimension of independent samples, which has one length; "
+                    "set it once in the configuration",
 }
 
 
@@ -391,6 +394,17 @@ def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None
     """:func:`sweep` of a checked grid, in ``folder`` (whose lock the caller holds) or in memory."""
     identity = _identity(base, grid)
     seed = base.get("seed")
+    keys = list(grid)
+    shape = tuple(len(v) for v in grid.values())
+    points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
+    # Every point's size before any file is touched (each point checks it again as it starts, with its
+    # workers, and then its precision and time, which need its scene); the seed does not change a size.
+    for i, assignment in enumerate(points):
+        try:
+            budget.check_memory(budget.memory_estimate(_point_config(base, assignment, i),
+                                                       streamed=folder is not None))
+        except SizeError as exc:
+            raise SizeError(f"Sweep point {i} ({_describe(assignment)}): {exc}") from None
     if folder is not None:
         if overwrite and not resume:
             _clear_folder(folder)
@@ -400,9 +414,6 @@ def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None
         # As runner.resolve_seed, once for the whole sweep: every point shares it.
         seed = int(np.random.SeedSequence().entropy)
     base = {**base, "seed": seed}
-    keys = list(grid)
-    shape = tuple(len(v) for v in grid.values())
-    points = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*grid.values())]
     cfgs = [_point_config(base, assignment, i) for i, assignment in enumerate(points)]
     t_common, n_nodes = _check_layout(cfgs, points)
 
@@ -620,8 +631,6 @@ def _check_layout(cfgs: list[Config], points: list[dict[str, Any]]) -> tuple[np.
                          f"begin with those of point {shortest} (the fewest steps); to sweep 'steps', record "
                          f"'all', an explicit list of times that holds every smaller 'steps', or 'log' with "
                          f"'steps' whole decades apart")
-        if c.realizations != cfgs[0].realizations:
-            raise refuse(0, i, f"{cfgs[0].realizations} and {c.realizations} realizations")
         if set(c.observables) != set(cfgs[0].observables):
             raise refuse(0, i, f"observables {sorted(cfgs[0].observables)} and {sorted(c.observables)}")
         # What decides the kernel, the nodes and the tilt test; the scene is built once per distinct one.

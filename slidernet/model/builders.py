@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import ast
 import csv
+import io
 import math
 import numbers
 from collections.abc import Mapping, Sequence
@@ -42,6 +43,7 @@ import networkx as nx
 import numpy as np
 import scipy.spatial
 
+from slidernet._validation import is_integral
 from slidernet.errors import ConfigError, param_error
 from slidernet.model.lattice import Lattice
 from slidernet.model.network import Network, chain
@@ -115,13 +117,6 @@ def _check_overrides(overrides: Mapping[str, Any], n_nodes: int, n_edges: int, o
                               f"an array of shape {shape}")
 
 
-def _is_integral(value: object) -> bool:
-    # Like chain(): accept 3 and 3.0 (TOML or JSON may give either) but not True.
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        return False
-    return math.isfinite(value) and int(value) == value
-
-
 def _lattice_shape(shape: object, owner: str) -> tuple[int, int]:
     """(rows, cols) as ints, or the standard ConfigError."""
     requirement = "two integers >= 1 with at least 2 nodes"
@@ -129,7 +124,7 @@ def _lattice_shape(shape: object, owner: str) -> tuple[int, int]:
         rows, cols = shape  # type: ignore[misc]
     except (TypeError, ValueError):
         raise param_error("shape", owner, requirement, shape) from None
-    if not (_is_integral(rows) and _is_integral(cols)):
+    if not (is_integral(rows) and is_integral(cols)):
         raise param_error("shape", owner, requirement, shape)
     rows, cols = int(rows), int(cols)
     if rows < 1 or cols < 1 or rows * cols < 2:
@@ -278,7 +273,7 @@ def irregular(n: int, Ntilde: float, rng: np.random.Generator, **overrides: Any)
     >>> bool((net.edges[:, 0] < net.edges[:, 1]).all())
     True
     """
-    if not _is_integral(n) or n < 3:
+    if not is_integral(n) or n < 3:
         raise param_error("n", "irregular", "an integer >= 3", n)
     if not isinstance(rng, np.random.Generator):
         raise param_error("rng", "irregular", "a numpy.random.Generator", type(rng).__name__)
@@ -440,8 +435,19 @@ def read_graph(path: str | PathLike[str], positions: Any = None) -> nx.Graph:
     """
     p = Path(path)
     suffix = _suffix(p, "read_graph")
+    if p.is_dir():
+        raise ConfigError(f"The network file {str(p)!r} is a folder, not a file.")
     if not p.is_file():
         raise ConfigError(f"The network file {str(p)!r} does not exist.")
+    try:
+        return _read_graph(p, suffix, positions)
+    except OSError as exc:  # no permission, ...: the reason in the system's words
+        raise ConfigError(f"The network file {str(exc.filename or p)!r} cannot be read: "
+                          f"{exc.strerror or exc}.") from None
+
+
+def _read_graph(p: Path, suffix: str, positions: Any) -> nx.Graph:
+    """:func:`read_graph` of a file that exists (the reading only)."""
     if suffix == ".graphml":
         G = _read_graphml(p)
         if positions is not None:
@@ -545,9 +551,23 @@ def _int(text: str, what: str, where: str) -> int:
         raise ConfigError(f"{where}: {what} must be an integer node id. Got {text!r} instead.") from None
 
 
+def _text(path: Path) -> io.StringIO:
+    """A network's text file (edge list, nodes file), read as UTF-8 (a byte-order mark is skipped), as a stream.
+
+    Not the locale's encoding: a file then reads the same on every machine, as the TOML file that names it.
+    """
+    data = path.read_bytes()
+    try:
+        return io.StringIO(data.decode("utf-8-sig"), newline="")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise ConfigError(f"The network file {str(path)!r} is not UTF-8 text: byte 0x{data[exc.start]:02x} on "
+                          f"line {line} cannot be decoded. Save it as UTF-8.") from None
+
+
 def _read_nodes_csv(path: Path) -> nx.Graph:
     G = nx.Graph()
-    with path.open(newline="") as f:
+    with _text(path) as f:
         reader = csv.DictReader(f)
         columns = [c.strip() for c in (reader.fieldnames or [])]
         allowed = {"node", "x", "y", "normal_load"}
@@ -592,7 +612,7 @@ def _spring_data(items: Mapping[Any, Any], where: str) -> dict[str, float]:
 
 
 def _read_edges_text(path: Path, G: nx.Graph) -> None:
-    with path.open() as f:
+    with _text(path) as f:
         for number, raw in enumerate(f, start=1):
             line = raw.split("#", 1)[0].strip()
             if not line:
@@ -622,7 +642,7 @@ def _read_edges_text(path: Path, G: nx.Graph) -> None:
 
 
 def _read_edges_csv(path: Path, G: nx.Graph) -> None:
-    with path.open(newline="") as f:
+    with _text(path) as f:
         reader = csv.DictReader(f)
         columns = [c.strip() for c in (reader.fieldnames or [])]
         ends = next((pair for pair in (("i", "j"), ("source", "target")) if set(pair) <= set(columns)), None)
@@ -686,14 +706,14 @@ def write_graph(net: Network, path: str | PathLike[str]) -> list[Path]:
         raise ConfigError(f"{str(p)!r}: an edge list cannot store the network's external forces f_ext; "
                           "write a '.graphml' file instead.")
     nodes = _nodes_file(p)
-    with nodes.open("w", newline="") as f:
+    with nodes.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["node", *axes, "normal_load"])
         # tolist() gives Python floats, whose str is the shortest exact repr.
         for v, (pos, load) in enumerate(zip(net.positions.tolist(), net.normal_load.tolist(), strict=True)):
             w.writerow([v, *pos, load])
     cols = zip(net.edges.tolist(), net.k.tolist(), net.kappa.tolist(), net.rest_length.tolist(), strict=True)
-    with p.open("w", newline="") as f:
+    with p.open("w", newline="", encoding="utf-8") as f:
         if suffix == ".csv":
             w = csv.writer(f)
             w.writerow(["i", "j", "k", "kappa", "rest_length"])
@@ -767,7 +787,7 @@ def build(kind: str, params: Mapping[str, Any], Ntilde: float,
         return chain(2, Ntilde=Ntilde, **overrides)
     if kind == "chain":
         n = own["n"]
-        if not _is_integral(n) or n < 2:
+        if not is_integral(n) or n < 2:
             raise param_error("n", "chain", "an integer >= 2", n)  # chain()'s own message
         _check_overrides(overrides, int(n), int(n) - 1, "chain")
         return chain(int(n), Ntilde=Ntilde, **overrides)

@@ -70,6 +70,9 @@ class PairBackend:
     """
 
     kernel: ClassVar[str] = "pair"
+    #: Slips per second of one worker, at least the measured 109.5 M/s (``python benchmarks/bench_vs_c.py``,
+    #: README), rounded up: the slow-run estimate of :mod:`slidernet.solver.budget` is a lower bound of a time.
+    slips_per_second: ClassVar[float] = 1.1e8
 
     def __init__(self, scene: Scene, real: Host) -> None:
         self.scene = scene
@@ -125,6 +128,10 @@ class NetworkBackend:
     """
 
     kernel: ClassVar[str]
+    #: Slips per second of one worker, rounded up from the fastest measured network (``python
+    #: benchmarks/bench_vs_c.py``, README: 6.55 M/s on a triangular 32 x 32 lattice; 4.58 M/s at 1e6 nodes,
+    #: 1.24 M/s on irregular networks of 1e6): the slow-run estimate of :mod:`slidernet.solver.budget`.
+    slips_per_second: ClassVar[float] = 1e7
 
     def __init__(self, scene: Scene, real: Host) -> None:
         self.scene = scene

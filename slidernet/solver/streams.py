@@ -57,10 +57,14 @@ def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random
     return streams
 
 
-def draw_thetas(scene: Scene, rng: np.random.Generator) -> np.ndarray:
-    """theta(t_q) from the driver plugin, checked: shape (steps + 1,), finite."""
-    thetas = checked_output(scene.driver.thetas(rng, scene.steps), (scene.steps + 1,), "driver",
-                            scene.driver_name, f"thetas(rng, {scene.steps})")
+def draw_thetas(scene: Scene, rng: np.random.Generator, steps: int | None = None) -> np.ndarray:
+    """theta(t_q) from the driver plugin, checked: shape (steps + 1,), finite.
+
+    ``steps`` defaults to the scene's; fewer draw a sample of the run's driver (``solver.budget``).
+    """
+    steps = scene.steps if steps is None else int(steps)
+    thetas = checked_output(scene.driver.thetas(rng, steps), (steps + 1,), "driver",
+                            scene.driver_name, f"thetas(rng, {steps})")
     return thetas
 
 

@@ -1,0 +1,427 @@
+"""What a run will cost, known before it starts: its memory, whether float64 can resolve it, its time.
+
+Three checks that :func:`slidernet.run` (and ``slidernet sweep``) make before
+any work, each from the configuration and, for the last two, the scene:
+
+- :func:`memory_estimate` and :func:`check_memory`: the bytes the run will
+  hold, from the configuration alone (before the network is built, which
+  may itself not fit), against the machine's memory (:func:`machine_memory`);
+  a run that cannot fit is refused with :class:`~slidernet.errors.SizeError`.
+- :func:`check_precision`: the forces of the kernels are sums of terms of
+  size |g_i| |theta| / Ntilde; where their rounding reaches 1/64 of the gap
+  mu_s - mu_d that a slip works across, the run is refused with
+  :class:`~slidernet.errors.PrecisionError`, naming the parameter that makes
+  the terms large or the gap small.
+- :func:`slips_per_tau` and :func:`warn_if_slow`: eq. ``slope``'s rate of
+  rearrangements, per driven node, gives the slips per tau_th; at a stated
+  rate of slips per second, a run that would take more than an hour gets one
+  :class:`~slidernet.errors.SlowRunWarning`, with the estimate.
+
+Every constant below was measured on the project's 2-core dev machine; the
+command is given with it, and the ensembles guide (docs/guides/ensembles-and-hpc.md,
+"Before a run") gives the figures and the estimates' errors.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from slidernet.config import Config
+from slidernet.errors import PrecisionError, SizeError, SlowRunWarning
+from slidernet.solver.backends import BACKENDS
+from slidernet.solver.scene import Scene, record_times
+from slidernet.solver.streams import draw_thetas
+
+# ---------------------------------------------------------------------------
+# memory
+
+#: Bytes per node of the scene, by kind of network: the peak of building the network, K and g, measured by
+#: ``python benchmarks/memory_budget.py`` as the growth of the peak resident memory between two sizes (chains
+#: of 2e5 and 2e6 nodes, lattices of 2e5 and 2e6, irregular networks of 1e5 and 1e6). A graph file counts as
+#: an irregular network (its reading through networkx comes on top).
+SCENE_BYTES = {"two_slider": 240.0, "chain": 240.0, "square": 128.0, "triangular": 144.0, "irregular": 793.0,
+               "graph": 793.0}
+#: Bytes per node of one realization's state (forces, displacements, thresholds, heaps), the same command
+#: (lattices of 2e5 and 2e6 nodes, two realizations).
+STATE_BYTES = 46.0
+#: Bytes per thermal step of a running realization: theta(t_q), drawn for the whole run at once (8 bytes
+#: a step; the same command).
+THETA_BYTES = 9.0
+#: Bytes per realization and recorded time of the records held (n, mu_max, x_G, the tilt sums, the network's
+#: series, and the dataset assembled from them), the same command (record = "all", 2e5 and 2e6 steps).
+RECORD_BYTES = 216.0
+#: Bytes per realization of the ensemble's bookkeeping (its task, its record's arrays and their dataset),
+#: held in memory (False) or with an output folder (True), the same command (2e3 and 1e4 realizations).
+REALIZATION_BYTES = {False: 7200.0, True: 5000.0}
+#: Realizations an output folder holds at once before writing them (``slidernet.analysis.observables.CHUNK``).
+STREAMED = 1024
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    """The bytes a run will hold at its peak, by part (each a lower bound: Python's own objects come on top).
+
+    Attributes
+    ----------
+    network : float
+        The scene: network, K, g (built once; local workers share it).
+    running : float
+        The realizations running at once, one per worker: their state and theta(t_q).
+    records : float
+        The records held: every realization's in memory, ``STREAMED`` at a time with an output folder.
+    ensemble : float
+        The bookkeeping of every realization of the run.
+    what : dict of str to str
+        For each part, what makes it large, in words, with the configuration keys to change.
+    """
+
+    network: float
+    running: float
+    records: float
+    ensemble: float
+    what: dict[str, str]
+
+    @property
+    def total(self) -> float:
+        """The whole estimate, bytes."""
+        return self.network + self.running + self.records + self.ensemble
+
+    def largest(self) -> str:
+        """The name of the largest part."""
+        parts = {"network": self.network, "running": self.running, "records": self.records,
+                 "ensemble": self.ensemble}
+        return max(parts, key=parts.__getitem__)
+
+
+def network_size(cfg: Config) -> int:
+    """The number of sliders of the configured network, known without building it (a graph file is read)."""
+    size = cfg.network.size()
+    if size is None:  # a graph: its file says
+        size = cfg.network.build().n_nodes
+    return int(size)
+
+
+def recorded_times(cfg: Config) -> int:
+    """How many times a realization records, without listing them (``record = "all"``: steps + 1)."""
+    if cfg.record == "all":
+        return cfg.steps + 1
+    return int(record_times(cfg.steps, cfg.record, cfg.log_points_per_decade).size)
+
+
+def memory_estimate(cfg: Config, workers: int = 1, *, streamed: bool = False) -> MemoryEstimate:
+    """The memory a run of ``cfg`` will hold at its peak, from the configuration alone.
+
+    Parameters
+    ----------
+    cfg : Config
+        The run.
+    workers : int
+        Realizations running at once (local worker processes; 1 in process).
+    streamed : bool
+        The records go to an output folder, ``STREAMED`` realizations at a time,
+        instead of staying in memory.
+
+    Returns
+    -------
+    MemoryEstimate
+        Bytes by part. The constants are this module's (measured); the event
+        catalogue's rows are not counted (their number is known only after
+        the run; at most ``solver.max_events`` per realization).
+
+    Examples
+    --------
+    >>> from slidernet.config import load_config
+    >>> cfg = load_config({"steps": 10**6, "realizations": 100, "record": "all",
+    ...                    "network": {"kind": "chain", "n": 1000, "Ntilde": 1e-7},
+    ...                    "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    ...                    "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}})
+    >>> est = memory_estimate(cfg, workers=2)
+    >>> est.largest(), round(est.records / 1e9, 1)  # 100 realizations x 1e6 + 1 recorded times x 216 B
+    ('records', 21.6)
+    """
+    R = cfg.realizations
+    nodes = network_size(cfg)
+    running = min(int(workers), R)
+    times = recorded_times(cfg)
+    held = min(R, STREAMED + running) if streamed else R
+    records_hint = "the records of each realization at each recorded time ('record', 'steps', 'realizations'" + (
+        ")" if streamed else "; an output folder, --out, writes them 1024 realizations at a time)")
+    return MemoryEstimate(
+        network=SCENE_BYTES[cfg.network.kind] * nodes,
+        running=running * (STATE_BYTES * nodes + THETA_BYTES * (cfg.steps + 1)),
+        records=RECORD_BYTES * held * times,
+        ensemble=REALIZATION_BYTES[streamed] * R,
+        what={
+            "network": f"the network of {nodes:,} sliders, about {SCENE_BYTES[cfg.network.kind]:.0f} bytes each "
+                       f"({_size_keys(cfg)})",
+            "running": f"the {running} realization(s) running at once, each drawing theta for all of its "
+                       f"{cfg.steps:,} steps, {THETA_BYTES:.0f} bytes a step, and holding {STATE_BYTES:.0f} bytes "
+                       f"a slider ('steps'; fewer workers)",
+            "records": f"{held:,} realizations x {times:,} recorded times, about {RECORD_BYTES:.0f} bytes each: "
+                       + records_hint,
+            "ensemble": f"the bookkeeping of {R:,} realizations, about {REALIZATION_BYTES[streamed]:.0f} bytes "
+                        f"each ('realizations')",
+        },
+    )
+
+
+def _size_keys(cfg: Config) -> str:
+    return {"chain": "'network.n'", "irregular": "'network.n'", "square": "'network.shape'",
+            "triangular": "'network.shape'", "graph": "'network.path'", "two_slider": "'network.kind'"}[
+        cfg.network.kind]
+
+
+def machine_memory() -> int | None:
+    """This machine's memory in bytes, or the smaller limit of its control group (a batch job's); None if unknown.
+
+    The physical memory (``os.sysconf``), lowered to the cgroup's ``memory.max`` (v2) or
+    ``memory.limit_in_bytes`` (v1) where one is set: the memory a job of a batch system may use.
+    """
+    total: int | None = None
+    try:
+        total = int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, ValueError, OSError):  # not a POSIX system
+        pass
+    for limit_file in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            text = Path(limit_file).read_text().strip()
+        except OSError:
+            continue
+        if text.isdigit():  # "max" where there is no limit
+            total = int(text) if total is None else min(total, int(text))
+    return total
+
+
+def check_memory(estimate: MemoryEstimate, *, available: int | None = None) -> None:
+    """Refuse a run whose estimated memory exceeds the machine's, with one line giving both.
+
+    Parameters
+    ----------
+    estimate : MemoryEstimate
+        The run's (:func:`memory_estimate`). A sweep checks each point as it starts it.
+    available : int, optional
+        The machine's memory in bytes (default: :func:`machine_memory`; no
+        check where it is unknown).
+
+    Raises
+    ------
+    SizeError
+        Naming the estimate, the machine's memory and the largest part, with
+        the keys that make it large.
+    """
+    available = machine_memory() if available is None else available
+    if available is None or estimate.total <= available:
+        return
+    part = estimate.largest()
+    raise SizeError(
+        f"This run needs about {_bytes(estimate.total)} of memory, more than this machine's {_bytes(available)}: "
+        f"most of it for {estimate.what[part]}. The estimate counts the arrays slidernet allocates (docs/guides/"
+        f"ensembles-and-hpc.md, 'Before a run')."
+    )
+
+
+def _bytes(n: float) -> str:
+    """A size in words: '23.4 GB', '480 TB' (powers of 1000)."""
+    for unit, scale in (("EB", 1e18), ("PB", 1e15), ("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{n:.3g} bytes"
+
+
+# ---------------------------------------------------------------------------
+# the scales of a scene: theta, the thermal loads, the gap a slip works across
+
+#: Thermal steps of the driver drawn to measure theta's scale (from a generator of its own: the run's
+#: streams are not touched).
+SAMPLE_STEPS = 1 << 16
+
+@dataclass(frozen=True)
+class Scales:
+    """The sizes that decide a scene's precision and its rate of slips.
+
+    Attributes
+    ----------
+    theta : float
+        max |theta(t_q)| / Ntilde over ``SAMPLE_STEPS`` steps of the driver.
+    step : float
+        The mean |theta(t_q+1) - theta(t_q)| / Ntilde over the same steps.
+    load : ndarray, shape (N,)
+        |g_i|, the thermal load of each node (its norm in 2D), in N per unit theta / Ntilde.
+    normal_load : ndarray, shape (N,)
+        N_i, in units of N.
+    f_ext : float
+        max |f_ext,i|, in N.
+    gap : float
+        The median of mu_s - mu_d under the truncated law (a median: it exists where a power law has
+        no mean; for the study's laws it is the mean).
+    mu_s : float
+        The median of mu_s.
+    """
+
+    theta: float
+    step: float
+    load: np.ndarray
+    normal_load: np.ndarray
+    f_ext: float
+    gap: float
+    mu_s: float
+
+
+def scales(cfg: Config, scene: Scene) -> Scales:
+    """The :class:`Scales` of a scene: a short sample of its driver, the median of its law of mu_s.
+
+    The law is asked for its median (``ppf(0.5)``), never sampled: a plugin's draws belong to the run.
+    """
+    net = scene.network
+    thetas = draw_thetas(scene, np.random.default_rng(0), min(scene.steps, SAMPLE_STEPS)) / net.Ntilde
+    g = np.asarray(scene.operators.g, dtype=np.float64).reshape(net.n_nodes, -1)
+    with np.errstate(all="ignore"):
+        mu = float(scene.distribution.ppf(0.5))
+    f_ext = np.asarray(net.f_ext, dtype=np.float64).reshape(net.n_nodes, -1)
+    return Scales(theta=float(np.abs(thetas).max()), step=float(np.abs(np.diff(thetas)).mean()),
+                  load=np.sqrt((g * g).sum(axis=1)), normal_load=np.asarray(net.normal_load, dtype=np.float64),
+                  f_ext=float(np.sqrt((f_ext * f_ext).sum(axis=1)).max(initial=0.0)),
+                  gap=mu - scene.mu_d, mu_s=mu)
+
+
+# ---------------------------------------------------------------------------
+# precision
+
+#: The largest share of the gap (mu_s - mu_d) N_i that the rounding of a force, eps times its largest term,
+#: may reach. Chains of 8 stopped in avalanches that never end (AvalancheError, 1e8 slips in one step) at
+#: 28 % (after 8 s) and at 2.8 % (after 71 s); at 0.28 % one ran 100 s without (``python
+#: benchmarks/precision_limit.py``). 1/64 = 1.6 % lies below the smallest share measured to stop.
+PRECISION_SHARE = 1.0 / 64
+
+
+def check_precision(cfg: Config, scene: Scene, found: Scales | None = None) -> None:
+    """Refuse a scene whose forces float64 cannot resolve, naming the parameter that causes it.
+
+    Inside the kernels a force is F_i = a_i + g_i theta / Ntilde (a = -K u + ...): its terms grow with
+    |g_i| |theta| / Ntilde and |f_ext,i|, and float64 rounds it to about eps = 2^-52 times them. A slip
+    works across the gap (mu_s - mu_d) N_i between the static and the dynamic threshold. Where the
+    rounding reaches :data:`PRECISION_SHARE` of that gap, the slips are no longer resolved: the run
+    stops in an avalanche that never ends, or computes wrong slips.
+
+    Raises
+    ------
+    PrecisionError
+        With the size of the terms, their rounding, the gap, and the parameter to change.
+    """
+    s = scales(cfg, scene) if found is None else found
+    terms = float(s.load.max(initial=0.0)) * s.theta + s.f_ext + s.mu_s * float(s.normal_load.max())
+    rounding = np.finfo(np.float64).eps * terms
+    gap = s.gap * float(s.normal_load.min())
+    if rounding <= PRECISION_SHARE * gap:
+        return
+    raise PrecisionError(
+        f"float64 cannot resolve this run's slips: its forces are sums of terms up to {terms:.3g} N, rounded to "
+        f"about {rounding:.3g} N, which is {rounding / gap:.3g} of the gap (mu_s - mu_d) N_i = {gap:.3g} N that "
+        f"a slip works across (beyond 1/64 runs stop in avalanches that never end). Lost floating-point "
+        f"precision; the cause: {precision_cause(cfg, s)}."
+    )
+
+
+def precision_cause(cfg: Config, s: Scales) -> str:
+    """The parameter that makes a scene's force terms large, or its gap small, in words (for a message).
+
+    Each candidate is measured against the paper's scene (|theta| / Ntilde of order 10, thermal loads
+    of order 1, unit normal loads, mu_s - mu_d of order 0.1); the one furthest from it is named.
+    """
+    net = cfg.network
+    load = float(s.load.max(initial=0.0))
+    spring = ("'network.kappa'" if abs(net.kappa or 1.0) > (net.k or 1.0) else "'network.k'") \
+        if cfg.network.kind != "graph" else "the springs' k and kappa in 'network.path'"
+    nmin = float(s.normal_load.min())
+    candidates = {
+        f"'driver' with 'network.Ntilde' (|theta| / Ntilde reaches {s.theta:.3g}; sigma_theta / Ntilde "
+        f"sets it)": s.theta / 10.0,
+        f"{spring} (thermal loads g = k L kappa up to {load:.3g})": load,
+        f"'network.normal_load' (down to {nmin:.3g} N)": 1.0 / nmin if nmin > 0 else math.inf,
+        f"'friction.static' with 'friction.mu_d' (mu_s - mu_d of {s.gap:.3g}: draws close to mu_d)":
+            0.1 / s.gap if s.gap > 0 else math.inf,
+        f"'network.f_ext' or 'network.incline' (loads up to {s.f_ext:.3g} N)": s.f_ext,
+    }
+    return max(candidates, key=candidates.__getitem__)
+
+
+# ---------------------------------------------------------------------------
+# time
+
+#: Estimated seconds above which a run gets a SlowRunWarning.
+SLOW_SECONDS = 3600.0
+
+
+def slips_per_tau(cfg: Config, scene: Scene, found: Scales | None = None) -> float:
+    """Estimated rearrangements per tau_th of one realization, from eq. ``slope`` applied to each driven node.
+
+    A node i is loaded by g_i theta / Ntilde; a thermal step moves theta by a mean |Δθ|, so its force by
+    |g_i| |Δθ| / Ntilde, and each slip takes 2 (mu_s - mu_d) N_i off it (mu_s the law's median). So
+
+    .. math:: r = \\sum_i \\frac{|g_i|\\, \\langle|\\Delta\\theta|\\rangle}{2 (\\mu_s - \\mu_d) N_i \\tilde N},
+
+    and for the paper's two sliders, whose one spring relieves both, one node's share (eq. ``slope``
+    without its offset: <|Δθ|> = 2 sigma_theta / sqrt(pi) for ``gaussian_steps``). Against the study's
+    measured slips per tau_th (docs/guides/aging-networks.md; ``python benchmarks/slip_rate_estimate.py``)
+    it is 1.96 times the measured rate for two sliders at sigma_theta / Ntilde = 1 (eq. ``slope``'s offset,
+    left out) and 1.06 at 10; 0.9 to 1.96 for chains of 2 to 16 and 0.6 to 1.2 for irregular networks of
+    16 to 4096 at sigma_theta / Ntilde = 1; at sigma_theta / Ntilde = 10, where the slips of one driving
+    event spread into the network, 0.54 to 1.03 for irregular networks and down to 0.09 for chains of 16.
+    So a run the warning spares may take up to 11 times the estimate (a chain of 16 at sigma_theta /
+    Ntilde = 10); it never takes less than half of it.
+    """
+    s = scales(cfg, scene) if found is None else found
+    if s.gap <= 0:
+        return math.inf
+    per_node = s.load * s.step / (2.0 * s.gap * s.normal_load)
+    if scene.network.is_two_slider():
+        return float(per_node.max())
+    return float(per_node.sum())
+
+
+def warn_if_slow(cfg: Config, scene: Scene, workers: int = 1, found: Scales | None = None) -> float:
+    """Warn once (:class:`~slidernet.errors.SlowRunWarning`) if the run would take more than an hour.
+
+    The estimate is ``realizations x steps x`` :func:`slips_per_tau`, at the backend's ``slips_per_second`` per
+    worker (the pair kernel's, or the network kernels'), on ``min(workers, realizations)`` workers.
+
+    Returns
+    -------
+    float
+        The estimated seconds.
+    """
+    rate = slips_per_tau(cfg, scene, found)
+    slips = rate * cfg.steps * cfg.realizations
+    per_second = BACKENDS[scene.kernel].slips_per_second
+    parallel = min(int(workers), cfg.realizations)
+    seconds = slips / (per_second * parallel)
+    if seconds > SLOW_SECONDS:
+        warnings.warn(
+            f"This run would take about {_duration(seconds)}: about {rate:.3g} slips per tau_th (eq. slope for "
+            f"each driven node) x {cfg.steps:,} steps x {cfg.realizations:,} realizations = {slips:.3g} slips, "
+            f"at {per_second:.3g} slips/s on each of {parallel} worker(s). A smaller sigma_theta / Ntilde, "
+            f"fewer steps or realizations shorten it.",
+            SlowRunWarning, stacklevel=3)
+    return seconds
+
+
+def _duration(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "for ever"
+    for unit, scale in (("years", 3.156e7), ("days", 86400.0), ("hours", 3600.0)):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds / 60:.3g} minutes"
+
+
+def check_run(cfg: Config, scene: Scene, workers: int = 1) -> None:
+    """The checks of a scene before its run: :func:`check_precision`, then :func:`warn_if_slow`."""
+    found = scales(cfg, scene)
+    check_precision(cfg, scene, found)
+    warn_if_slow(cfg, scene, workers, found)
