@@ -81,7 +81,10 @@ The sliding rule and the slip rule are those of the configuration keys:
 ``--min-slips M`` and ``--min-displacement X`` are ``[tilt] min_slips`` and
 ``min_displacement`` (defaults 1 and 0, the rule of every earlier result).
 A stricter rule costs more slips per test; run the script once per rule to
-compare (the rule is printed in the first line).
+compare (the rule is printed in the first line). A configuration with a
+``[tilt]`` table must ask for ``mu_eff``, so with ``--min-slips`` or
+``--min-displacement`` the scenes record ``mu_eff`` at t = 0: one untimed
+test of the fresh state, which also fills part of the tilt draw buffers.
 """
 
 from __future__ import annotations
@@ -164,7 +167,11 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None,
     if "overshoot" in rule:
         cfg["friction"] = FRICTION | {"overshoot": rule.pop("overshoot")}
     if rule:
+        # The [tilt] table is refused without mu_eff, whose rule it sets: the scene then records mu_eff at
+        # t = 0 only, one untimed test of the fresh state before the timed ones.
         cfg["tilt"] = rule
+        cfg["observables"] = ["n", "mu_eff"]
+        cfg["record"] = [0]
     return cfg
 
 

@@ -53,8 +53,8 @@ class FrictionConfig(_Strict):
         description="The distribution p(mu_s) of the static thresholds: a registered name and its "
                     "parameters; conditioned on mu_s > mu_d.")
     overshoot: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = Field(
-        None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's magnitude (None: 1, the "
-                          "paper's undamped slip; 0: the slip stops at mu_d N).")
+        None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's "
+                          "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).")
 
     def slip_factor(self) -> float:
         """1 + e, the slip's length over ``(|F_i| - mu_d N_i) / K_ii`` (2.0: the paper's)."""
