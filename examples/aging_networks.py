@@ -1,5 +1,5 @@
 """Does thermal cycling age the static friction of a network of sliders? With the controls a referee asks for
-=========================================================================================================
+==========================================================================================================
 
 The paper (Geminard & Bertin 2010) ends on an open question: in a 2D
 irregular network of sliders, does the effective friction coefficient still
