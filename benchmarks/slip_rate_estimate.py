@@ -1,8 +1,9 @@
 """The estimate of slips per tau_th of slidernet.solver.budget against the study's measured rates.
 
 ``python benchmarks/slip_rate_estimate.py`` (a few seconds; no run, only scenes): for each row of the table
-of docs/guides/aging-networks.md ("slips/tau_th", the rate of rearrangements measured over 16 realizations
-of the horizontal evolution, 300 to 1e4 tau_th), :func:`slidernet.solver.budget.slips_per_tau` from the
+of docs/guides/aging-networks.md as of commit a921f70 (the earlier grid of ``examples/aging_networks.py``:
+"slips/tau_th", the rate of rearrangements measured over 16 realizations of the horizontal evolution, 300 to
+1e4 tau_th, network seed 0), :func:`slidernet.solver.budget.slips_per_tau` from the
 same configuration (``examples/aging_networks.toml`` with the row's network, sigma_mu and sigma_theta), and
 the ratio estimate / measured. The slow-run warning (:func:`slidernet.solver.budget.warn_if_slow`) and the
 ensembles guide ("Before a run") quote these ratios as the estimate's error.

@@ -189,10 +189,12 @@ PRESETS = {
         ),
         mechanism=(("pair", 2), ("chain", 16), ("irregular", 64)),
     ),
-    # Beyond the full preset's budget: 4096 sliders, 8 geometries x 4 realizations, the three parameter sets.
+    # Beyond the full preset's budget: 4096 sliders, 8 geometries x 2 realizations to 300 tau_th, at the base
+    # and at the control where the pair ages, with the pair at the same times (about 25 min of CPU).
     "large": Preset(
-        realizations=32, steps=1000, per_decade=5,
-        groups=(Group("irregular_4096", "irregular", (4096,), geometries=8),),
+        realizations=16, steps=300, per_decade=5,
+        groups=(Group("pair", "pair", (2,), ("base", "ratio0.3")),
+                Group("irregular_4096", "irregular", (4096,), ("base", "ratio0.3"), geometries=8)),
         mechanism=(),
     ),
     "quick": Preset(
@@ -564,7 +566,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="a small grid, short runs (seconds); "
                         "the same as --preset quick")
     parser.add_argument("--preset", choices=sorted(PRESETS), default="full",
-                        help="full (the study), quick, or large (4096 sliders, beyond the full preset's budget)")
+                        help="full (the study), quick, or large (4096 sliders and the pair, base and ratio0.3, "
+                             "300 tau_th)")
     parser.add_argument("--workers", type=int, default=None, help="worker processes per sweep point")
     parser.add_argument("--scheduler", default=None,
                         help="a Dask scheduler address, e.g. tcp://host:8786: realizations run on that cluster")
