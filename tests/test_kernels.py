@@ -41,7 +41,9 @@ class PairState:
         nothing = np.empty(0)
         self.out = kernels.Series(n=np.zeros(T, np.int64), mu_max=np.zeros(T), x_G=np.zeros(T),
                                   n_records=np.zeros(T, np.int64), mu_mean=nothing, mu_min=nothing, y_G=nothing,
-                                  f_sum=np.zeros(T), f_sq=np.zeros(T), f_count=np.zeros(T, np.int64))
+                                  f_sum=np.zeros(T), f_sq=np.zeros(T), f_count=np.zeros(T, np.int64),
+                                  contact_age=nothing,
+                                  contact_age_count=np.zeros((0, kernels.N_AGE_BINS), np.int64))
 
     def run(self, thetas, mu_buf, mu_d: float = MU_D, slip_factor: float = 2.0) -> int:
         draws = kernels.Draws(np.asarray(mu_buf, dtype=float), np.empty(0), np.empty(0))

@@ -20,6 +20,8 @@ from collections.abc import Iterable, Iterator
 import numpy as np
 import xarray as xr
 
+from slidernet.kernels.state import AGE_EDGES
+
 ATTRS = {
     "n": {"long_name": "cumulative number of rearrangements (slips)", "units": "1"},
     "mu_max": {"long_name": "largest static threshold mu_s in the network", "units": "1"},
@@ -32,6 +34,8 @@ ATTRS = {
                                      "network tilt test at t", "units": "1"},
     "tilt_all_moving": {"long_name": "load f + f_bar at which an avalanche of the tilt test at t first set every "
                                      "node in motion at once, above mu_d or not (NaN: none did)", "units": "1"},
+    "contact_age": {"long_name": "mean over the nodes of the time since each node last slipped in the horizontal "
+                                 "evolution (since t = 0 for a node that has not slipped)", "units": "tau_th"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
                                         "(NaN: none)", "units": "1"},
 }
@@ -160,7 +164,7 @@ def realization_variables(records: list[Record], observables: list[str], first_r
         ``event`` for the event catalogue).
     """
     out: Variables = {}
-    for name in ("n", "mu_max", "x_G", "n_records"):
+    for name in ("n", "mu_max", "x_G", "n_records", "contact_age"):
         if name in observables:
             out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
     if "mu_eff_realization" in observables:
@@ -217,7 +221,7 @@ class EnsembleStats:
         The last recorded time, for the rate ``r = n(steps) / steps``.
     """
 
-    MOMENTS = ("n", "mu_max", "x_G", "n_records")
+    MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age")
 
     def __init__(self, observables: list[str], steps: int) -> None:
         self.observables = list(observables)
@@ -225,6 +229,7 @@ class EnsembleStats:
         self.R = 0
         self._moments: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # name -> (mean, M2)
         self._f: dict[str, np.ndarray] = {}
+        self._age_count: np.ndarray | None = None  # (T, bins) int64: the nodes' ages, summed over realizations
 
     def _merge(self, name: str, x: np.ndarray) -> None:
         """Fold the chunk ``x`` (B, ...) into the running (mean, M2) of ``name``."""
@@ -250,6 +255,9 @@ class EnsembleStats:
                     self._merge("x_G2", x**2)
         if "n" in self.observables and self.steps > 0:
             self._merge("r", np.array([[r["n"][-1] / self.steps] for r in records]))
+        if "contact_age" in self.observables:
+            counts = np.stack([r["contact_age_count"] for r in records]).sum(axis=0)
+            self._age_count = counts if self._age_count is None else self._age_count + counts
         for name in ("v_creep", "v_creep_cycle"):
             if name in records[0]:
                 self._merge(name, np.array([[r[name]] for r in records], dtype=np.float64))
@@ -291,6 +299,10 @@ class EnsembleStats:
                 mean, sem = self._mean_sem("x_G2")
                 out["x_G2_mean"] = ("t", mean, {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
                 out["x_G2_sem"] = ("t", sem, {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+        if self._age_count is not None:
+            out["contact_age_count"] = (("t", "contact_age_bin"), self._age_count, {
+                "long_name": "number of (realization, node) pairs whose contact age at t lies in the bin "
+                             "[contact_age_bin, contact_age_upper)", "units": "1"})
         if "r" in self._moments:
             mean, sem = self._mean_sem("r")
             out["r_mean"] = ((), mean[0], {"long_name": "mean rearrangements per tau_th", "units": "1"})
@@ -342,6 +354,13 @@ def coordinates(t: np.ndarray, R: int, first: Record) -> dict[str, tuple]:
     if "avalanche_count" in first:
         bins = first["avalanche_count"].size
         coords["avalanche_size"] = ("avalanche_size", 2 ** np.arange(bins, dtype=np.int64))
+    if "contact_age_count" in first:
+        # Fixed edges (kernels.AGE_EDGES), the same for every run: histograms of runs and sweeps stack.
+        edges = np.concatenate([[0.0], AGE_EDGES, [np.inf]])
+        coords["contact_age_bin"] = ("contact_age_bin", edges[:-1], {
+            "long_name": "lower edge of the contact-age bin (4 per decade from 1e-6)", "units": "tau_th"})
+        coords["contact_age_upper"] = ("contact_age_bin", edges[1:], {
+            "long_name": "upper edge of the contact-age bin (excluded)", "units": "tau_th"})
     if "cycle_end" in first:
         C = first["cycle_end"].size
         coords["cycle"] = ("cycle", np.arange(1, C + 1, dtype=np.int64),

@@ -11,11 +11,13 @@ calls them as the tables do.
 from __future__ import annotations
 
 
-def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -> str:
+def choose_kernel(requested: str, two_slider: bool, dim: int, node_state: bool) -> str:
     """The kernel a scene runs on: the one rule, used by the scene and by the checks of a configuration.
 
     ``auto`` gives ``pair`` (scalars only) for the paper's two sliders unless
-    the event catalogue is kept (observables "events" and "creep"; it needs per-node state), and else the
+    the scene needs per-node state (``node_state``: the event catalogue of the observables "events" and
+    "creep", each node's last slip of "contact_age"; on a 2-node chain the network kernel gives the pair
+    kernel's bits, ARCHITECTURE.md invariant 6), and else the
     network kernel of the dimension: ``csr`` in 1D, ``vec`` in 2D. A kernel
     named in ``solver.kernel`` is returned as it is (the scene refuses one
     that cannot run its network).
@@ -27,7 +29,7 @@ def choose_kernel(requested: str, two_slider: bool, dim: int, catalogue: bool) -
     """
     if requested != "auto":
         return requested
-    if two_slider and not catalogue:
+    if two_slider and not node_state:
         return "pair"
     return "csr" if dim == 1 else "vec"
 

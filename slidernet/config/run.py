@@ -33,12 +33,12 @@ from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
 OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
-               "creep")
+               "creep", "contact_age")
 
 #: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
 NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
 Observable = Literal["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
-                     "creep",
+                     "creep", "contact_age",
                      "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
 
 
@@ -152,7 +152,8 @@ class Config(_Strict):
             choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies())
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
-        for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue")):
+        for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue"),
+                           ("contact_age", "each node's last slip")):
             if self.solver.kernel == "pair" and name in self.observables:
                 raise ValueError(f"the {name!r} observable ({what}) needs a network kernel; "
                                  "use 'solver.kernel = \"auto\"' or '\"csr\"'")
@@ -211,11 +212,16 @@ class Config(_Strict):
         if dim is None:
             return None, False  # a graph file that cannot be read: building the scene reports it
         two = pair is not None and pair.is_two_slider()
-        return dim, choose_kernel(self.solver.kernel, two, dim, self.needs_catalogue()) == "pair"
+        return dim, choose_kernel(self.solver.kernel, two, dim, self.needs_node_state()) == "pair"
 
     def needs_catalogue(self) -> bool:
         """True if the kernel keeps the event catalogue: for the observable 'events', or 'creep' (read from it)."""
         return "events" in self.observables or "creep" in self.observables
+
+    def needs_node_state(self) -> bool:
+        """True if the scene needs a network kernel's per-node state: the event catalogue, or each node's last
+        slip (observable 'contact_age'); a two-slider scene then runs on the 'csr' kernel."""
+        return self.needs_catalogue() or "contact_age" in self.observables
 
     def tilt_settings(self) -> TiltConfig:
         """The [tilt] table, or its defaults where it is not given."""

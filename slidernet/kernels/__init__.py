@@ -40,8 +40,10 @@ from slidernet.kernels.chain import init_chain_heaps, run_chain, run_chain_tilt
 from slidernet.kernels.pair import run_pair, run_pair_tilt
 from slidernet.kernels.plane import init_plane_heaps, run_plane, run_plane_exact, stiffness_times
 from slidernet.kernels.state import (
+    AGE_EDGES,
     AVALANCHE_LIMIT,
     DONE,
+    N_AGE_BINS,
     N_AVALANCHE_BINS,
     NEED_EVENTS,
     NEED_MU,
@@ -66,11 +68,13 @@ from slidernet.kernels.state import (
 from slidernet.kernels.tilt import tilt_status, tilt_test_pair
 
 __all__ = [
+    "AGE_EDGES",
     "AVALANCHE_LIMIT",
     "DONE",
     "NEED_EVENTS",
     "NEED_MU",
     "NEED_TILT",
+    "N_AGE_BINS",
     "N_AVALANCHE_BINS",
     "RECOMPUTE",
     "SLID_AWAY",

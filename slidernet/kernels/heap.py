@@ -44,8 +44,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from slidernet.kernels.jit import kernel_jit
-from slidernet.kernels.state import DONE, DOWN, NEED_EVENTS, NEED_MU, TREE_ARITY, UNSTABLE, UP, nonneg
+from slidernet.kernels.state import AGE_EDGES, DONE, DOWN, NEED_EVENTS, NEED_MU, TREE_ARITY, UNSTABLE, UP, nonneg
 
 
 @kernel_jit(forceinline=True)
@@ -382,6 +384,23 @@ def write_output(st, mu, out):
     if out.mu_mean.size:
         out.mu_mean[k], out.mu_min[k] = mu_stats(mu)
     st.next_out = k + 1
+
+
+@kernel_jit()
+def write_ages(t, last_slip, out, k):
+    """Write the contact ages at time t (tau_th) into output slot k: their mean and their histogram.
+
+    The age of node i is t - ``last_slip[i]`` (the event time of its last
+    slip, 0.0 if it has not slipped). The mean is t - mean(last_slip), the
+    sum in node order; each age is binned against
+    :data:`~slidernet.kernels.state.AGE_EDGES` (bin 0: below the first
+    edge). O(N log bins), at output steps only.
+    """
+    total = 0.0
+    for j in range(last_slip.size):
+        total += last_slip[j]
+        out.contact_age_count[k, np.searchsorted(AGE_EDGES, t - last_slip[j], side="right")] += 1
+    out.contact_age[k] = t - total / last_slip.size
 
 
 @kernel_jit(forceinline=True)

@@ -48,6 +48,7 @@ from slidernet.kernels.heap import (
     redraw_threshold,
     theta_direction,
     tree_set,
+    write_ages,
     write_output,
 )
 from slidernet.kernels.jit import kernel_jit
@@ -75,6 +76,8 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     if not ok:
         return False
     log_event(st, catalogue, i, dux, duy)
+    if nodes.last_slip.size:  # contact_age: the slip's time is its driving event's (0-length: not recorded)
+        nodes.last_slip[i] = st.event_time
     # The new threshold first, so that one pass over the row both moves the forces and re-keys the
     # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
     # as moving every force first).
@@ -102,12 +105,24 @@ def every_node_moving(st, nodes, i):
 
 
 @kernel_jit(forceinline=True)
+def record(st, nodes, out, t):
+    """Write the state into the next output slot; t is the time of that state, in tau_th.
+
+    The contact ages are written only where the scene records them (``nodes.last_slip`` not 0-length).
+    """
+    if nodes.last_slip.size:
+        write_ages(t, nodes.last_slip, out, st.next_out)
+    write_output(st, nodes.mu, out)
+
+
+@kernel_jit(forceinline=True)
 def slide_away(st, nodes, out, out_steps):
-    """The network slides away: record when, and hold the state of that moment in the records left."""
+    """The network slides away: record when, and hold the state of that moment in the records left
+    (contact ages included: their time is the slide's)."""
     st.slid_away = 1
     st.slid_away_at = st.event_time
     while st.next_out < out_steps.size:
-        write_output(st, nodes.mu, out)
+        record(st, nodes, out, st.slid_away_at)
     return SLID_AWAY
 
 
@@ -220,7 +235,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             if status != DONE:
                 return status
         if close_t0(st, out_steps):
-            write_output(st, nodes.mu, out)
+            record(st, nodes, out, 0.0)
         if settings.recompute_every > 0 and st.since_recompute >= settings.recompute_every:
             return RECOMPUTE
         if st.q >= steps:
@@ -245,4 +260,4 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
                 return slide_away(st, nodes, out, out_steps)
             continue
         if end_step(st, thetas, out_steps):
-            write_output(st, nodes.mu, out)
+            record(st, nodes, out, float(st.q))

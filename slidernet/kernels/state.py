@@ -60,6 +60,13 @@ TILT_NEED_DRAWS = -1.0  # a draw buffer ran out (pair: positions left as they we
 TILT_TOO_LONG = -2.0  # the test gave up: TILT_MAX_ITER iterations (pair), or why in pos[STOP] (network)
 N_AVALANCHE_BINS = 63  # avalanche sizes s are binned by floor(log2 s); 2**62 fits in int64
 
+#: The fixed bin edges of the contact ages (observable ``contact_age``), in tau_th: 4 bins per decade from
+#: 1e-6 to 1e9, so that the histograms of every run, realization and sweep point stack. Bin 0 holds the
+#: ages in [0, 1e-6) (a node that slipped within 1e-6 tau_th of the record), bin b >= 1 the ages in
+#: [AGE_EDGES[b - 1], AGE_EDGES[b]), the last bin the ages from 1e9 on.
+AGE_EDGES = 10.0 ** (np.arange(-24, 37) / 4.0)
+N_AGE_BINS = AGE_EDGES.size + 1
+
 #: The scalars of a realization, one record. Units are the kernels' (theta in
 #: Ntilde, lengths in Ntilde l0, see :mod:`slidernet.kernels`).
 STATE = np.dtype([
@@ -210,6 +217,11 @@ class Series(NamedTuple):
     f_sum: np.ndarray  # the tilt test's samples in the bin ending at the step: sum,
     f_sq: np.ndarray  # sum of squares,
     f_count: np.ndarray  # and count (int64)
+    # Observable contact_age (network kernels; 0-length elsewhere): each record's mean over the nodes of
+    # the time since the node last slipped, in tau_th, shape (T,), and the nodes' ages binned by
+    # AGE_EDGES, int64, shape (T, N_AGE_BINS).
+    contact_age: np.ndarray
+    contact_age_count: np.ndarray
 
 
 class Catalogue(NamedTuple):
@@ -231,6 +243,9 @@ class Nodes(NamedTuple):
     # slipped; -1: none.
     moving: np.ndarray
     # Written only with Settings.slide_away.
+    # (N,) float64, 0-length unless the scene records contact_age: the event time (tau_th) of the last
+    # slip of each node in the horizontal evolution; 0.0 for a node that has not slipped since t = 0.
+    last_slip: np.ndarray
 
 
 class Chain(NamedTuple):

@@ -142,7 +142,9 @@ class NetworkBackend:
                                    node_slips=np.zeros(N, np.int64),
                                    avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64),
                                    # Read only where the scene can slide away: 0-length elsewhere.
-                                   moving=np.full(N if scene.slide_away else 0, -1, np.int64))
+                                   moving=np.full(N if scene.slide_away else 0, -1, np.int64),
+                                   # Read and written only where the scene records contact_age.
+                                   last_slip=np.zeros(N if scene.contact_age else 0))
         # The unstable heap, and the driving trees over the driven nodes (g_i != 0).
         self.heaps = kernels.Heaps.empty(1, N, driven=np.any(g.reshape(N, -1) != 0.0, axis=1))
         # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows (fewer where

@@ -27,7 +27,8 @@ from slidernet.solver.snapshot import Snapshot, check_fingerprint, digest, scene
 from slidernet.solver.streams import Streams
 
 # Series fields a scene does not record, as the kernels take them (0-length arrays, never written).
-_NOTHING = {"mu_mean": np.empty(0), "mu_min": np.empty(0), "y_G": np.empty(0)}
+_NOTHING = {"mu_mean": np.empty(0), "mu_min": np.empty(0), "y_G": np.empty(0), "contact_age": np.empty(0),
+            "contact_age_count": np.zeros((0, kernels.N_AGE_BINS), np.int64)}
 
 # The attributes of a Realization that a snapshot carries, and those the constructor rebuilds (and why that
 # is exact). A new attribute must join one of the two: snapshot() refuses a realization holding another.
@@ -97,6 +98,8 @@ class Realization:
             "f_sq": np.zeros(T),
             "f_count": np.zeros(T, np.int64),
         }
+        if scene.contact_age:
+            self.out.update(contact_age=np.zeros(T), contact_age_count=np.zeros((T, kernels.N_AGE_BINS), np.int64))
         if scene.tilt_loads:
             self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
         self._tilted = 0  # recorded times whose network tilt test is done

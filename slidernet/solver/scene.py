@@ -155,6 +155,7 @@ class Scene:
     catalogue: bool = False  # the kernel keeps the event catalogue (for 'events' or 'creep')
     tilt_loads: bool = False  # the network tilt tests record their loads at the first slip and collective motion
     max_events: int = 0
+    contact_age: bool = False  # the network kernel keeps each node's last slip time (observable 'contact_age')
     keep_events: bool = True  # the catalogue's rows go into the result (observable 'events')
     creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
     slide_away: bool = False
@@ -198,7 +199,7 @@ class Scene:
         family, operators = _operators(net)
         catalogue = cfg.needs_catalogue()
         two_slider = net.is_two_slider()
-        kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, catalogue)
+        kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, cfg.needs_node_state())
         if kernel != family and not (kernel == "pair" and two_slider):
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
@@ -235,6 +236,7 @@ class Scene:
             recompute_every=cfg.solver.recompute_every,
             slip_mode=SLIP_EXACT if cfg.solver.slip == "exact" else SLIP_STRAIGHT,
             catalogue=catalogue,
+            contact_age="contact_age" in cfg.observables,
             max_events=cfg.solver.max_events,
             keep_events="events" in cfg.observables,
             creep=creep_spec(cfg, net) if "creep" in cfg.observables else None,
