@@ -37,13 +37,15 @@ SCENES = {
     "pair_tilt": make_config(**{"steps": 120, "record": "all", "observables": [*BASE, "mu_eff"],
                                 "solver.batch": 16}),
     "csr_tilt_events_fext": network_config({"kind": "chain", "n": 6, "f_ext": 0.02}, 60,
-                                           [*BASE, "mu_eff", "events"], **{"solver.recompute_every": 50}),
+                                           [*BASE, "mu_eff", "events", "contact_age"],
+                                           **{"solver.recompute_every": 50}),
     # max_events = 350 with 64-row chunks: at S/3 the kernel's buffer has been cut to the 30 rows
     # left, and the cap is reached after the checkpoint.
     "csr_events_capped": network_config({"kind": "two_slider"}, 60, [*BASE, "events"],
                                         **{"solver.max_events": 350}),
     "vec_straight_tilt_events_fext": network_config(
-        {"kind": "triangular", "shape": [4, 5], "f_ext": [0.02, -0.01]}, 60, [*BASE, "mu_eff", "events"]),
+        {"kind": "triangular", "shape": [4, 5], "f_ext": [0.02, -0.01]}, 60,
+        [*BASE, "mu_eff", "events", "contact_age"]),
     # The exact slip costs ~1 ms a slip with the tilt test: a small lattice, few steps.
     "vec_exact_tilt_events": network_config({"kind": "triangular", "shape": [3, 3]}, 12,
                                             [*BASE, "mu_eff", "events"],
