@@ -137,6 +137,31 @@ def test_a_scene_without_contact_age_keeps_no_last_slip() -> None:
     assert real.backend.nodes.last_slip.size == 0 and real.series.contact_age.size == 0
 
 
+def test_a_snapshot_from_before_last_slip_restores_where_it_is_not_kept() -> None:
+    """A checkpoint written before ``nodes/last_slip`` existed resumes a scene that does not keep it; a scene
+    that keeps it refuses such a snapshot by the array's name."""
+    from slidernet.errors import SnapshotError
+    from slidernet.solver.snapshot import Snapshot
+
+    def old_snapshot(observables: list[str]) -> tuple[Scene, Snapshot, Realization]:
+        scene = Scene.from_config(load_config(_config({"kind": "chain", "n": 6}, observables=observables)))
+        real = Realization(scene, np.random.SeedSequence(1))
+        real.advance(3)
+        snap = real.snapshot()
+        arrays = {k: v for k, v in snap.arrays.items() if k != "backend/nodes/last_slip"}
+        return scene, Snapshot(snap.header, arrays), real
+
+    scene, snap, real = old_snapshot(["n"])
+    again = Realization(scene, np.random.SeedSequence(1))
+    again.restore(snap)
+    real.advance(6)
+    again.advance(6)
+    assert np.array_equal(again.backend.nodes.u, real.backend.nodes.u)
+    scene, snap, _ = old_snapshot(["n", "contact_age"])
+    with pytest.raises(SnapshotError, match="last_slip"):
+        Realization(scene, np.random.SeedSequence(1)).restore(snap)
+
+
 def test_two_sliders_with_contact_age_run_on_the_network_kernel_and_the_pair_kernel_refuses_it() -> None:
     cfg = _config(NETWORKS["two_slider"])
     assert Scene.from_config(load_config(cfg)).kernel == "csr"

@@ -270,6 +270,8 @@ class NetworkBackend:
         """
         # In place: the kernels get arrays of exactly the layout and dtype they were compiled for.
         for name, target in self._named_arrays().items():
+            if target.size == 0 and name not in arrays:
+                continue  # kept by scenes that ask for it only; absent from snapshots written before it existed
             target[...] = take(arrays, name, target)
         k = int(real.state["ev_pos"][0])
         rows = int(take(arrays, "events/buffer_rows", dtype=np.int64, ndim=0))
