@@ -322,6 +322,7 @@ def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry:
     mu_s_mean = float(law.mean_max(1))  # the law's mean, conditioned on mu_s > mu_d
     q = ds["mu_eff_realization"]
     slips = (ds["n"] / N).where(ds["t"] >= 1)
+    excess = math.sqrt(N) * (q - p.mu_d)  # the scaled excess over mu_d, flat for an excess ~ 1/sqrt(N)
     point = {
         "group": group.name, "kind": group.kind, "size": size, "N": N, "params": params,
         "mu_d": p.mu_d, "std": p.std, "ratio": p.ratio, "overshoot": group.overshoot,
@@ -331,14 +332,14 @@ def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry:
         "r_mean": mean_sem(ds["n"].isel(t=-1).values / float(ds["t"][-1]))[0],
         "slips_per_node_end": _estimate(slips.isel(t=-1).values, geometry),
         "mu_eff": _trend(q, geometry),
-        "sqrtN_excess": _trend(math.sqrt(N) * (q - p.mu_d), geometry),
-        "sqrtN_excess_vs_slips": _trend(math.sqrt(N) * (q - p.mu_d), geometry, against=slips),
+        "sqrtN_excess": _trend(excess, geometry),
+        "sqrtN_excess_vs_slips": _trend(excess, geometry, against=slips),
         "law_units": _trend((q - mu_s_mean) / p.std, geometry),
         "mu_max": _trend(ds["mu_max"], geometry),
         "mu_eff_at": group.mu_eff_at,
         # The weakest link: with no prestress, the first node to yield is the weakest of N.
         "weakest_of_N": float(mean_min_quadrature(law, N)),
-        "curves": {"mu_eff": _curve(q), "sqrtN_excess": _curve(math.sqrt(N) * (q - p.mu_d)),
+        "curves": {"mu_eff": _curve(q), "sqrtN_excess": _curve(excess),
                    "slips_per_node": _curve(ds["n"] / N)},
         "configs": configs,
     }
