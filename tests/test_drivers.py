@@ -42,12 +42,13 @@ def driver_params(series_csv: Path) -> dict[str, dict]:
         "ornstein_uhlenbeck": {"sigma_theta": 1e-6, "tau_c": 3.0},
         "sinusoidal": {"amplitude": 1e-6, "period": 10.0, "noise_std": 1e-7},
         "ramp": {"rate": 1e-7, "period": 20.0},
+        "constant": {"theta0": 1e-7},
         "series": {"path": str(series_csv), "kappa": 1e-5, "T0": 20.0, "tau_th": 60.0},
     }
 
 
 def test_builtins_are_registered():
-    assert set(BUILTINS) == {"gaussian_steps", "ornstein_uhlenbeck", "sinusoidal", "ramp", "series"}
+    assert set(BUILTINS) == {"gaussian_steps", "ornstein_uhlenbeck", "sinusoidal", "ramp", "constant", "series"}
     assert set(BUILTINS) <= set(registry.drivers.names())
 
 
@@ -361,7 +362,10 @@ def test_each_driver_runs_end_to_end(series_csv, name):
     n = ds["n"].values
     assert n.shape == (2, 51)
     assert (np.diff(n, axis=1) >= 0).all()
-    assert (n[:, -1] > 0).all()  # every driver moves theta by many Ntilde: rearrangements happen
+    if name == "constant":
+        assert (n == 0).all()  # theta never moves: nothing slips
+    else:
+        assert (n[:, -1] > 0).all()  # every other driver moves theta by many Ntilde: rearrangements happen
     assert np.isfinite(ds["mu_max"].values).all() and np.isfinite(ds["x_G"].values).all()
 
 

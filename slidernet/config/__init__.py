@@ -46,7 +46,13 @@ from slidernet.config.execution import SCHEDULER_REQUIREMENT, ExecutionConfig, i
 from slidernet.config.loading import build_network, load_config, read_toml
 from slidernet.config.loading import tomllib as tomllib  # the TOML reader the tests share
 from slidernet.config.network import NetworkConfig
-from slidernet.config.plugins import FrictionConfig, PluginSpec, build_distribution, is_finite
+from slidernet.config.plugins import (
+    FrictionConfig,
+    PluginSpec,
+    StrengtheningConfig,
+    build_distribution,
+    is_finite,
+)
 from slidernet.config.rules import PAIR_TILT_ONLY, choose_kernel, choose_tilt_at
 from slidernet.config.run import NETWORK_OBSERVABLES, OBSERVABLES, Config, Observable
 from slidernet.config.solver import SolverConfig
@@ -55,6 +61,6 @@ from slidernet.config.units import UnitsConfig
 
 __all__ = ["NETWORK_OBSERVABLES", "OBSERVABLES", "PAIR_TILT_ONLY", "SCHEDULER_REQUIREMENT", "Config",
            "CreepConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "NetworkConfig", "Observable",
-           "PluginSpec", "PositiveFloat", "SolverConfig", "TiltConfig", "UnitsConfig", "build_distribution",
-           "build_network",
+           "PluginSpec", "PositiveFloat", "SolverConfig", "StrengtheningConfig", "TiltConfig", "UnitsConfig",
+           "build_distribution", "build_network",
            "choose_kernel", "choose_tilt_at", "is_finite", "is_scheduler_address", "load_config", "read_toml"]

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import inspect
 import math
-from typing import Annotated, Any, ClassVar
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from slidernet.config.base import PositiveFloat, _Strict
 from slidernet.errors import ConfigError
@@ -35,6 +35,42 @@ class PluginSpec(BaseModel):
         return dict(self.model_extra or {})
 
 
+class StrengtheningConfig(_Strict):
+    """Contact strengthening: a contact's static threshold grows with the time since its last renewal.
+
+    mu_s,i(a) = mu_s,i^0 + beta L(a / tau_c), with a the age of node i's
+    contact (the time since it last slipped, in tau_th; since t = 0 for a
+    node that has not slipped) and mu_s,i^0 the threshold drawn at that
+    renewal. ``law = "log"``: L(x) = ln(1 + x) (Dieterich; Baumberger and
+    Caroli); ``law = "power"``: L(x) = (1 + x)^p - 1 with ``exponent`` p in
+    (0, 1]. Both laws are built into the kernels rather than registered as
+    plugins: the kernels evaluate the law inside the event search, and a
+    user's compiled function passed to a kernel becomes an address in its
+    machine code, which numba cannot cache.
+    """
+
+    law: Literal["log", "power"] = Field(
+        "log", description="'log': beta ln(1 + a/tau_c); 'power': beta ((1 + a/tau_c)^exponent - 1).")
+    beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+        description="beta >= 0: the strengthening's amplitude, in units of mu_s (0: the option has no effect).")
+    tau_c: Annotated[float, Field(gt=0, allow_inf_nan=False)] = Field(
+        description="tau_c > 0: the age at which strengthening sets in, in tau_th.")
+    exponent: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] | None = Field(
+        None, description="The power law's exponent p in (0, 1] (law = 'power' only).")
+
+    @model_validator(mode="after")
+    def _exponent_with_power_law(self) -> StrengtheningConfig:
+        if self.law == "power" and self.exponent is None:
+            raise ValueError("law = 'power' needs an 'exponent' in (0, 1]")
+        if self.law == "log" and self.exponent is not None:
+            raise ValueError("'exponent' belongs to law = 'power'; the 'log' law has none")
+        return self
+
+    def constants(self) -> tuple[float, float, float]:
+        """(beta, tau_c, exponent) as the kernels take them; exponent 0.0 stands for the logarithmic law."""
+        return float(self.beta), float(self.tau_c), 0.0 if self.law == "log" else float(self.exponent)
+
+
 class FrictionConfig(_Strict):
     """Dynamic coefficient mu_d, the distribution of static thresholds mu_s, and the slip rule.
 
@@ -46,7 +82,7 @@ class FrictionConfig(_Strict):
     reaches mu_d N_i. It applies to every kernel and to both tilt tests.
     """
 
-    _omit_if_none: ClassVar[tuple[str, ...]] = ("overshoot",)
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("overshoot", "strengthening")
 
     mu_d: PositiveFloat = Field(description="Dynamic friction coefficient mu_d (dimensionless).")
     static: PluginSpec = Field(
@@ -55,6 +91,9 @@ class FrictionConfig(_Strict):
     overshoot: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = Field(
         None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's "
                           "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).")
+    strengthening: StrengtheningConfig | None = Field(
+        None, description="Contact strengthening, the [friction.strengthening] table (None: thresholds do not "
+                          "age).")
 
     def slip_factor(self) -> float:
         """1 + e, the slip's length over ``(|F_i| - mu_d N_i) / K_ii`` (2.0: the paper's)."""

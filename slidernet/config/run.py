@@ -148,8 +148,16 @@ class Config(_Strict):
             if any(t > self.steps for t in self.record):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         size = self.network.size()
+        if self.friction.strengthening is not None:
+            if self.mu_eff_at == "rearrangements":
+                raise ValueError("'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every "
+                                 "rearrangement) is made on thresholds that do not age; with "
+                                 "[friction.strengthening] use 'mu_eff_at = \"records\"'")
+            if self.solver.kernel == "pair":
+                raise ValueError("[friction.strengthening] needs a network kernel (each contact's age); use "
+                                 "'solver.kernel = \"auto\"' or '\"csr\"'")
         if self.mu_eff_at == "rearrangements":  # the network is built only for this check, where it may be a pair
-            choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies())
+            choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies())
         if self.solver.kernel == "pair" and size not in (2, None):
             raise ValueError("the 'solver.kernel' value 'pair' needs a 2-slider network")
         for name, what in (("events", "the event catalogue"), ("creep", "computed from the event catalogue"),
@@ -162,15 +170,15 @@ class Config(_Strict):
             if name in self.observables and "mu_eff" not in self.observables:
                 raise ValueError(f"the {name!r} observable ({what}) needs the tilt tests of 'mu_eff'; add "
                                  "\"mu_eff\" to 'observables'")
-        if "tilt_loads" in self.observables and choose_tilt_at(self.mu_eff_at,
-                                                               self.network.pair_tilt_applies()) != "records":
+        if ("tilt_loads" in self.observables
+                and choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records"):
             raise ValueError("the 'tilt_loads' observable is read from the network tilt test at the recorded "
                              "times: set 'mu_eff_at = \"records\"'")
         if self.tilt is not None and not self.tilt.is_default():
             if "mu_eff" not in self.observables:
                 raise ValueError("the [tilt] table sets the sliding rule of the network tilt test of 'mu_eff', "
                                  "which is not asked for; add \"mu_eff\" to 'observables' or remove the table")
-            if choose_tilt_at(self.mu_eff_at, self.network.pair_tilt_applies()) != "records":
+            if choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records":
                 raise ValueError("the [tilt] table sets the sliding rule of the network tilt test, and this run's "
                                  "mu_eff is the appendix's test before every rearrangement: set "
                                  "'mu_eff_at = \"records\"'")
@@ -220,8 +228,16 @@ class Config(_Strict):
 
     def needs_node_state(self) -> bool:
         """True if the scene needs a network kernel's per-node state: the event catalogue, or each node's last
-        slip (observable 'contact_age'); a two-slider scene then runs on the 'csr' kernel."""
-        return self.needs_catalogue() or "contact_age" in self.observables
+        slip (observable 'contact_age', or [friction.strengthening]); a two-slider scene then runs on the 'csr'
+        kernel."""
+        return (self.needs_catalogue() or "contact_age" in self.observables
+                or self.friction.strengthening is not None)
+
+    def pair_tilt_applies(self) -> bool:
+        """True if the appendix's tilt test before every rearrangement can be this run's mu_eff: a 1D pair
+        (:meth:`NetworkConfig.pair_tilt_applies`) whose thresholds do not strengthen (its test reads the
+        pair kernel's thresholds, which have no age)."""
+        return self.friction.strengthening is None and self.network.pair_tilt_applies()
 
     def tilt_settings(self) -> TiltConfig:
         """The [tilt] table, or its defaults where it is not given."""

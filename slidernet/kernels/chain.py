@@ -18,12 +18,15 @@ from slidernet.kernels.heap import heap_set, set_critical
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.network import init_heaps, no_tilt, run_network
 from slidernet.kernels.state import UNSTABLE, nonneg
+from slidernet.kernels.strength import refresh
 from slidernet.kernels.tilt import tilt_sample
 
 
 @kernel_jit(forceinline=True)
-def update_node(net, nodes, heaps, j, theta):
-    """Re-key node j in the three heaps after its force or threshold changed."""
+def update_node(net, nodes, heaps, j, theta, t):
+    """Re-key node j in the three heaps after its force or threshold changed (its threshold first brought
+    up to time t, tau_th, where contacts strengthen)."""
+    refresh(nodes, j, t)
     a = nodes.a
     g = net.g
     F = abs(a[j] + g[j] * theta)
@@ -81,7 +84,7 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta):
         q = nonneg(p)  # the compiler does not carry lo >= 0 over to p
         j = nonneg(net.indices[q])
         nodes.a[j] -= net.K_data[q] * dux
-        update_node(net, nodes, heaps, j, theta)
+        update_node(net, nodes, heaps, j, theta, st.event_time)
 
 
 @kernel_jit(forceinline=True)
@@ -110,6 +113,6 @@ def run_chain_tilt(thetas, out_steps, net, state, nodes, heaps, draws, catalogue
 
 
 @kernel_jit()
-def init_chain_heaps(net, state, nodes, heaps):
-    """:func:`slidernet.kernels.network.init_heaps` on a 1D network."""
-    init_heaps(net, state, nodes, heaps, update_node)
+def init_chain_heaps(net, state, nodes, heaps, t):
+    """:func:`slidernet.kernels.network.init_heaps` on a 1D network, at time t (tau_th)."""
+    init_heaps(net, state, nodes, heaps, t, update_node)

@@ -8,7 +8,8 @@ the slip, how a slip moves the forces -- comes in as five functions of the
 geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
 of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 
-* ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heap and trees;
+* ``update_node(net, nodes, heaps, j, theta, t)``: re-key node j in the heap and trees (its
+  threshold first brought up to time t where contacts strengthen);
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
@@ -53,15 +54,17 @@ from slidernet.kernels.heap import (
 )
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, nonneg
+from slidernet.kernels.strength import refresh_all, strengthened_event
 
 
 @kernel_jit(inline="always")
-def init_heaps(net, state, nodes, heaps, update_node):
-    """(Re)build the unstable heap and the driving trees from scratch, O(N log N) at most."""
+def init_heaps(net, state, nodes, heaps, t, update_node):
+    """(Re)build the unstable heap and the driving trees from scratch, O(N log N) at most; t is the time
+    of the state (tau_th), at which strengthening thresholds are brought up to date."""
     st = state[0]
     heap_clear(heaps)
     for j in range(nodes.mu.size):
-        update_node(net, nodes, heaps, j, st.theta)
+        update_node(net, nodes, heaps, j, st.theta, t)
 
 
 @kernel_jit(inline="always")
@@ -82,6 +85,8 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
     # as moving every force first).
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
+    if nodes.mu0.size:  # strengthening: the renewed contact starts at its drawn threshold, age 0
+        nodes.mu0[i] = nodes.mu[i]
     move_node(net, st, nodes, heaps, i, dux, duy, theta)
     return True
 
@@ -108,9 +113,12 @@ def every_node_moving(st, nodes, i):
 def record(st, nodes, out, t):
     """Write the state into the next output slot; t is the time of that state, in tau_th.
 
-    The contact ages are written only where the scene records them (``nodes.last_slip`` not 0-length).
+    The contact ages are written only where the scene records them (``out.contact_age`` not 0-length);
+    with strengthening every threshold is first brought up to time t.
     """
-    if nodes.last_slip.size:
+    if nodes.mu0.size:
+        refresh_all(st, nodes, t)
+    if out.contact_age.size:
         write_ages(t, nodes.last_slip, out, st.next_out)
     write_output(st, nodes.mu, out)
 
@@ -242,7 +250,10 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             return DONE
         s = theta_direction(st, thetas)
         turn(net, nodes, heaps, s, critical_roots)
-        best, thc = next_driving_event(st, heaps, thetas, s)
+        if nodes.mu0.size:
+            best, thc = strengthened_event(st, net, nodes, heaps, thetas, s, critical_roots)
+        else:
+            best, thc = next_driving_event(st, heaps, thetas, s)
         if best >= 0:
             best = nonneg(best)
             st.theta = thc

@@ -31,6 +31,7 @@ from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.memory import prefetch
 from slidernet.kernels.network import init_heaps, no_tilt, run_network
 from slidernet.kernels.state import UNSTABLE, nonneg
+from slidernet.kernels.strength import refresh
 
 _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
@@ -182,8 +183,10 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd):
 
 
 @kernel_jit(forceinline=True)
-def update_node(net, nodes, heaps, j, theta):
-    """Re-key node j in the three heaps after its force or threshold changed."""
+def update_node(net, nodes, heaps, j, theta, t):
+    """Re-key node j in the three heaps after its force or threshold changed (its threshold first brought
+    up to time t, tau_th, where contacts strengthen)."""
+    refresh(nodes, j, t)
     a = nodes.a
     gx = net.g[j, 0]
     gy = net.g[j, 1]
@@ -357,7 +360,7 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta):
         q = nonneg(p)  # lo >= 0, but the compiler does not carry that over to p
         j = nonneg(net.indices[q])
         _pushed(net, nodes.a, q, j, dux, duy)
-        update_node(net, nodes, heaps, j, theta)
+        update_node(net, nodes, heaps, j, theta, st.event_time)
 
 
 @kernel_jit()
@@ -391,6 +394,6 @@ def run_plane_exact(thetas, out_steps, net, state, nodes, heaps, draws, catalogu
 
 
 @kernel_jit()
-def init_plane_heaps(net, state, nodes, heaps):
-    """:func:`slidernet.kernels.network.init_heaps` on a 2D network."""
-    init_heaps(net, state, nodes, heaps, update_node)
+def init_plane_heaps(net, state, nodes, heaps, t):
+    """:func:`slidernet.kernels.network.init_heaps` on a 2D network, at time t (tau_th)."""
+    init_heaps(net, state, nodes, heaps, t, update_node)

@@ -243,9 +243,17 @@ class Nodes(NamedTuple):
     # slipped; -1: none.
     moving: np.ndarray
     # Written only with Settings.slide_away.
-    # (N,) float64, 0-length unless the scene records contact_age: the event time (tau_th) of the last
-    # slip of each node in the horizontal evolution; 0.0 for a node that has not slipped since t = 0.
+    # (N,) float64, 0-length unless the scene records contact_age or its contacts strengthen: the event
+    # time (tau_th) of the last slip of each node in the horizontal evolution; 0.0 for a node that has not
+    # slipped since t = 0.
     last_slip: np.ndarray
+    # Contact strengthening (friction.strengthening; both 0-length without it, and then never read): the
+    # threshold mu_s,i^0 drawn at each node's last renewal, (N,) float64, and the law's constants
+    # (beta, tau_c in tau_th, exponent; exponent 0: the logarithmic law), (3,) float64. ``mu`` then holds
+    # each node's strengthened threshold at the time it was last brought up to date
+    # (:mod:`slidernet.kernels.strength`).
+    mu0: np.ndarray
+    law: np.ndarray
 
 
 class Chain(NamedTuple):

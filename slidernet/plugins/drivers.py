@@ -19,6 +19,7 @@ name                        theta(t_q)
 ``ornstein_uhlenbeck``      stationary Gaussian, correlation time ``tau_c``
 ``sinusoidal``              a periodic cycle plus independent Gaussian noise
 ``ramp``                    ``theta0 + rate t``, or a triangle wave
+``constant``                ``theta0`` at every t: no thermal cycling
 ``series``                  ``kappa (T(t0 + q tau_th) - T0)`` from a CSV file
 ==========================  ==================================================
 """
@@ -270,6 +271,39 @@ class Ramp:
         return f"Ramp(rate={self.rate!r}, theta0={self.theta0!r}, period={self.period!r})"
 
 
+class Constant:
+    """theta(t_q) = theta0 at every t_q: no thermal cycling at all.
+
+    The control of a study of cycling (sigma_theta / Ntilde = 0): nothing
+    slips, so only what evolves without slips is seen, such as contact
+    strengthening (``friction.strengthening``). The ``rng`` is not used.
+
+    Parameters
+    ----------
+    theta0 : float, optional
+        theta at every t (dimensionless); default 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Constant(theta0=2e-7).thetas(np.random.default_rng(0), 3)
+    array([2.e-07, 2.e-07, 2.e-07, 2.e-07])
+    """
+
+    # Parameters for slidernet.testing.check_driver and the plugin contract test.
+    example_params: ClassVar[dict[str, Any]] = {"theta0": 1e-7}
+
+    def __init__(self, theta0: float = 0.0) -> None:
+        self.theta0 = check_scalar(theta0, "theta0", "constant")
+
+    def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:
+        """theta at t = 0 ... steps (in tau_th), shape ``(steps + 1,)``; ``rng`` is unused."""
+        return np.full(steps + 1, self.theta0, dtype=np.float64)
+
+    def __repr__(self) -> str:
+        return f"Constant(theta0={self.theta0!r})"
+
+
 def _read_series(path: Path, delimiter: str, owner: str) -> tuple[np.ndarray, np.ndarray]:
     """The (time, temperature) columns of a CSV file, checked; a header row is optional."""
     where = f"The temperature file {str(path)!r} of the {owner} driver"
@@ -424,5 +458,6 @@ BUILTINS: dict[str, type] = {
     "ornstein_uhlenbeck": OrnsteinUhlenbeck,
     "sinusoidal": Sinusoidal,
     "ramp": Ramp,
+    "constant": Constant,
     "series": Series,
 }

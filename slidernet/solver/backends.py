@@ -137,14 +137,18 @@ class NetworkBackend:
         self.scene = scene
         N = scene.network.n_nodes
         g = scene.operators.g
+        strong = scene.strengthening is not None
         # a = F - theta g with u = 0: every spring at rest at theta(0), plus the external load.
         self.nodes = kernels.Nodes(a=-g * real.thetas[0] + self._f_ext(), u=np.zeros_like(g), mu=real.mu,
                                    node_slips=np.zeros(N, np.int64),
                                    avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64),
                                    # Read only where the scene can slide away: 0-length elsewhere.
                                    moving=np.full(N if scene.slide_away else 0, -1, np.int64),
-                                   # Read and written only where the scene records contact_age.
-                                   last_slip=np.zeros(N if scene.contact_age else 0))
+                                   # Read and written only where the scene records contact_age or its
+                                   # contacts strengthen.
+                                   last_slip=np.zeros(N if scene.contact_age or strong else 0),
+                                   mu0=real.mu.copy() if strong else np.zeros(0),
+                                   law=np.array(scene.strengthening if strong else (), np.float64))
         # The unstable heap, and the driving trees over the driven nodes (g_i != 0).
         self.heaps = kernels.Heaps.empty(1, N, driven=np.any(g.reshape(N, -1) != 0.0, axis=1))
         # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows (fewer where
@@ -169,7 +173,7 @@ class NetworkBackend:
     _init_heaps: ClassVar[Callable[..., None]]
 
     def rebuild_heaps(self, real: Host) -> None:
-        type(self)._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps)
+        type(self)._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps, state_time(real))
 
     def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
@@ -333,6 +337,17 @@ class PlaneBackend(NetworkBackend):
         out = np.empty_like(u)
         kernels.stiffness_times(self.scene.operators, u, out)
         return out
+
+
+def state_time(real: Host) -> float:
+    """The time of the realization's state, in tau_th: q plus the fraction of step q that theta has covered
+    (q where theta stands still in the step, or at its start)."""
+    st = real.state[0]
+    q = int(st["q"])
+    thetas = real.thetas
+    if q + 1 >= thetas.size or thetas[q + 1] == thetas[q]:
+        return float(q)
+    return q + float((st["theta"] - thetas[q]) / (thetas[q + 1] - thetas[q]))
 
 
 # The one place where a kernel's name is read: the scene's choice picks the backend.

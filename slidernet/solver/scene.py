@@ -156,6 +156,8 @@ class Scene:
     tilt_loads: bool = False  # the network tilt tests record their loads at the first slip and collective motion
     max_events: int = 0
     contact_age: bool = False  # the network kernel keeps each node's last slip time (observable 'contact_age')
+    # friction.strengthening as the kernels take it, (beta, tau_c, exponent; 0: the log law); None: off
+    strengthening: tuple[float, float, float] | None = None
     keep_events: bool = True  # the catalogue's rows go into the result (observable 'events')
     creep: CreepSpec | None = None  # the creep observables' settings (observable 'creep')
     slide_away: bool = False
@@ -207,7 +209,8 @@ class Scene:
         tilt_at = None
         if "mu_eff" in cfg.observables:
             try:
-                tilt_at = choose_tilt_at(cfg.mu_eff_at, pair_tilt_applies(net))
+                tilt_at = choose_tilt_at(cfg.mu_eff_at,
+                                         pair_tilt_applies(net) and cfg.friction.strengthening is None)
             except ValueError as exc:  # a network given here that the configuration's checks never saw
                 raise ConfigError(f"The 'mu_eff_at' field: {exc}.") from None
         slide_away = mean_load(net) > cfg.friction.mu_d
@@ -237,6 +240,8 @@ class Scene:
             slip_mode=SLIP_EXACT if cfg.solver.slip == "exact" else SLIP_STRAIGHT,
             catalogue=catalogue,
             contact_age="contact_age" in cfg.observables,
+            strengthening=(None if cfg.friction.strengthening is None
+                           else cfg.friction.strengthening.constants()),
             max_events=cfg.solver.max_events,
             keep_events="events" in cfg.observables,
             creep=creep_spec(cfg, net) if "creep" in cfg.observables else None,

@@ -107,6 +107,8 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         "slip_factor": float(scene.slip_factor),
         "tilt_min_slips": int(scene.tilt_min_slips),
         "tilt_min_shift": float(scene.tilt_min_shift),
+        # Only where contacts strengthen: a scene without it keeps the fingerprint of earlier snapshots.
+        **({} if scene.strengthening is None else {"strengthening": list(scene.strengthening)}),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": digest(*(getattr(ops, name) for name in _K_FIELDS if name in ops._fields)),
