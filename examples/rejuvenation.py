@@ -147,8 +147,18 @@ def reduce_point(kind: str, N: int, beta: float, cycling: float, ds: xr.Dataset,
     slope_q = LN10 * trend["slope"].values
     r_node = ds["n"].isel(t=-1).values / (N * t_end)  # slips per node per tau_th, per realization
     age_end = age.isel(t=-1).values
+    # The ages of every (realization, node) at t_end, binned on the fixed edges (4 per decade): the share in
+    # the bin that holds t_end (for t_end = 1e2 or 1e3, an edge, exactly the contacts that never slipped) and
+    # the bin that holds the median age.
+    count = ds["contact_age_count"].isel(t=-1).values
+    lower, upper = ds["contact_age_bin"].values, ds["contact_age_upper"].values
+    last = int(np.searchsorted(lower, t_end, side="right")) - 1
+    median = int(np.searchsorted(np.cumsum(count), 0.5 * count.sum()))
     point = {
         "kind": kind, "N": N, "beta": beta, "tau_c": TAU_C, "cycling": cycling,
+        "share_in_t_end_bin": float(count[last] / count.sum()), "t_end_bin": [float(lower[last]),
+                                                                               float(upper[last])],
+        "median_age_bin": [float(lower[median]), float(upper[median])],
         "realizations": int(ds.sizes["realization"]), "t_end": t_end,
         "times": {f"{t:g}": {"mu_eff": _at(q, t), "mu_max": _at(ds["mu_max"], t), "contact_age": _at(age, t)}
                   for t in sorted({*(t for t in REPORT_TIMES if t < t_end), t_end})},
@@ -197,20 +207,26 @@ def _pm(e: dict[str, float] | None, scale: float = 1.0, digits: int = 4) -> str:
     return f"{e['mean'] * scale:.{digits}f} ± {e['sem'] * scale:.{digits}f}"
 
 
+def _bin(edges: list[float]) -> str:
+    return f"[{edges[0]:.2g}, {edges[1]:.2g})"
+
+
 def tables(data: dict[str, Any]) -> str:
     """The guide's tables, from the JSON."""
-    lines = ["| system | β | σ_θ/Ñ | μ_eff(0) | μ_eff(1) | μ_eff(t_end) | slope (1e−4/decade) | β ln10 (1e−4) "
-             "| ⟨a⟩(t_end) (τ_th) | r_node (1/τ_th) | ⟨a⟩ r_node | β ln(1+⟨a⟩/τ_c) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| system | β | σ_θ/Ñ | t_end | μ_eff(0) | μ_eff(1) | μ_eff(t_end) | slope (1e−4/decade) "
+             "| β ln10 (1e−4) | ⟨a⟩(t_end) (τ_th) | median a (τ_th) | ages in t_end's bin (never slipped) | r_node (1/τ_th) "
+             "| ⟨a⟩ r_node | β ln(1+⟨a⟩/τ_c) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in data["points"]:
         t_end = f"{p['t_end']:g}"
         name = "pair" if p["kind"] == "pair" else f"{p['kind']} {p['N']}"
         ar = p["age_times_rate"]
         lines.append(
-            f"| {name} | {p['beta']:g} | {p['cycling']:g} | {_pm(p['times']['0']['mu_eff'])} "
+            f"| {name} | {p['beta']:g} | {p['cycling']:g} | {t_end} | {_pm(p['times']['0']['mu_eff'])} "
             f"| {_pm(p['times']['1']['mu_eff'])} | {_pm(p['times'][t_end]['mu_eff'])} "
             f"| {_pm(p['mu_eff_slope_per_decade'], 1e4, 1)} | {p['strength_slope_per_decade'] * 1e4:.1f} "
-            f"| {_pm(p['contact_age_end'], 1.0, 3)} | {_pm(p['r_node'], 1.0, 3)} "
+            f"| {_pm(p['contact_age_end'], 1.0, 3)} | {_bin(p['median_age_bin'])} "
+            f"| {p['share_in_t_end_bin']:.3f} | {_pm(p['r_node'], 1.0, 3)} "
             f"| {'–' if ar is None else _pm(ar, 1.0, 2)} | {p['strength_mean_age']:.4f} |")
     return "\n".join(lines) + "\n"
 
