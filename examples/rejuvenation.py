@@ -214,8 +214,8 @@ def _bin(edges: list[float]) -> str:
 def tables(data: dict[str, Any]) -> str:
     """The guide's tables, from the JSON."""
     lines = ["| system | β | σ_θ/Ñ | t_end | μ_eff(0) | μ_eff(1) | μ_eff(t_end) | slope (1e−4/decade) "
-             "| β ln10 (1e−4) | ⟨a⟩(t_end) (τ_th) | median a (τ_th) | ages in t_end's bin (never slipped) | r_node (1/τ_th) "
-             "| ⟨a⟩ r_node | β ln(1+⟨a⟩/τ_c) |",
+             "| β ln10 (1e−4) | ⟨a⟩(t_end) (τ_th) | median a (τ_th) | ages in t_end's bin (never slipped) "
+             "| r_node (1/τ_th) | ⟨a⟩ r_node | β ln(1+⟨a⟩/τ_c) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in data["points"]:
         t_end = f"{p['t_end']:g}"
@@ -239,14 +239,17 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     axes = fig.subplots(2, len(betas), squeeze=False)
     cyclings = sorted({p["cycling"] for p in data["points"]})
     styles = dict(zip(cyclings, ["-", "--", "-.", ":"], strict=False))
+    systems = list(dict.fromkeys((p["kind"], p["N"]) for p in data["points"]))
+    colors = {system: f"C{i}" for i, system in enumerate(systems)}  # a colour per system, a style per amplitude
     for col, beta in enumerate(betas):
         top, bottom = axes[0, col], axes[1, col]
         for p in (p for p in data["points"] if p["beta"] == beta):
             t = np.asarray(p["curves"]["t"], dtype=float)
             keep = t > 0
             label = f"{'pair' if p['kind'] == 'pair' else p['kind'] + ' ' + str(p['N'])}, σ_θ/Ñ = {p['cycling']:g}"
-            top.plot(t[keep], np.asarray(p["curves"]["mu_eff"])[keep], styles[p["cycling"]], label=label, lw=1)
-            bottom.plot(t[keep], np.asarray(p["curves"]["contact_age"])[keep], styles[p["cycling"]], lw=1)
+            style = {"ls": styles[p["cycling"]], "color": colors[(p["kind"], p["N"])], "lw": 1}
+            top.plot(t[keep], np.asarray(p["curves"]["mu_eff"])[keep], label=label, **style)
+            bottom.plot(t[keep], np.asarray(p["curves"]["contact_age"])[keep], **style)
         top.set(xscale="log", title=f"β = {beta:g}" + (" (no strengthening)" if beta == 0 else ""),
                 ylabel="μ_eff (network tilt test)")
         bottom.set(xscale="log", yscale="log", xlabel="t (τ_th)", ylabel="mean contact age (τ_th)")

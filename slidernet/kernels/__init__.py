@@ -16,6 +16,9 @@ Delta u = 2 (mu_min - mu_d) s.
   K; :func:`run_chain`, and :func:`run_chain_tilt` for a 2-node chain with
   the appendix's test) and 2D (``plane.py``: vector forces, 2x2 blocks of
   K; :func:`run_plane`, straight-line slips, and :func:`run_plane_exact`);
+* with contact strengthening (``strength.py``), :func:`run_chain_aging`,
+  :func:`run_plane_aging` and :func:`run_plane_exact_aging`, compiled only
+  for scenes that ask for it;
 * ``tilt_net.py`` -- the network tilt test at the recorded times, compiled
   only where a scene asks for it (``tilt_test_network``, and
   ``tilt_test_network_exact`` for the exact 2D slip).
@@ -36,9 +39,23 @@ point when a buffer of random draws runs low, so that Python can refill it
 with the plugin's ``sample`` in batches.
 """
 
-from slidernet.kernels.chain import init_chain_heaps, run_chain, run_chain_tilt
+from slidernet.kernels.chain import (
+    init_chain_heaps,
+    init_chain_heaps_aging,
+    run_chain,
+    run_chain_aging,
+    run_chain_tilt,
+)
 from slidernet.kernels.pair import run_pair, run_pair_tilt
-from slidernet.kernels.plane import init_plane_heaps, run_plane, run_plane_exact, stiffness_times
+from slidernet.kernels.plane import (
+    init_plane_heaps,
+    init_plane_heaps_aging,
+    run_plane,
+    run_plane_aging,
+    run_plane_exact,
+    run_plane_exact_aging,
+    stiffness_times,
+)
 from slidernet.kernels.state import (
     AGE_EDGES,
     AVALANCHE_LIMIT,
@@ -92,14 +109,19 @@ __all__ = [
     "Series",
     "Settings",
     "init_chain_heaps",
+    "init_chain_heaps_aging",
     "init_plane_heaps",
+    "init_plane_heaps_aging",
     "new_state",
     "run_chain",
+    "run_chain_aging",
     "run_chain_tilt",
     "run_pair",
     "run_pair_tilt",
     "run_plane",
+    "run_plane_aging",
     "run_plane_exact",
+    "run_plane_exact_aging",
     "stiffness_times",
     "tilt_status",
     "tilt_test_pair",

@@ -16,17 +16,29 @@ from __future__ import annotations
 
 from slidernet.kernels.heap import heap_set, set_critical
 from slidernet.kernels.jit import kernel_jit
-from slidernet.kernels.network import init_heaps, no_tilt, run_network
+from slidernet.kernels.network import init_heaps, no_tilt, run_network, tree_event
 from slidernet.kernels.state import UNSTABLE, nonneg
-from slidernet.kernels.strength import refresh
+from slidernet.kernels.strength import refresh, strengthened_event
 from slidernet.kernels.tilt import tilt_sample
 
 
 @kernel_jit(forceinline=True)
 def update_node(net, nodes, heaps, j, theta, t):
-    """Re-key node j in the three heaps after its force or threshold changed (its threshold first brought
-    up to time t, tau_th, where contacts strengthen)."""
-    refresh(nodes, j, t)
+    """Re-key node j in the three heaps after its force or threshold changed (t, the time, is not read)."""
+    _update_node(net, nodes, heaps, j, theta, t, False)
+
+
+@kernel_jit(forceinline=True)
+def update_node_aging(net, nodes, heaps, j, theta, t):
+    """:func:`update_node` with contact strengthening: node j's threshold first brought up to time t (tau_th)."""
+    _update_node(net, nodes, heaps, j, theta, t, True)
+
+
+@kernel_jit(forceinline=True)
+def _update_node(net, nodes, heaps, j, theta, t, aging):
+    """Both re-keyings; ``aging`` is a constant of each caller, so LLVM's inlining removes the branch."""
+    if aging:
+        refresh(nodes, j, t)
     a = nodes.a
     g = net.g
     F = abs(a[j] + g[j] * theta)
@@ -74,6 +86,21 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
 def move_node(net, st, nodes, heaps, i, dux, duy, theta):
     """Displace node i by dux: the centre of mass, and the force offsets on the CSR row of K, each
     node of the row re-keyed (:func:`update_node`) as soon as its force is moved."""
+    _move_node(net, st, nodes, heaps, i, dux, theta, False)
+
+
+@kernel_jit(forceinline=True)
+def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
+    """:func:`move_node` with contact strengthening (:func:`update_node_aging` at the avalanche's time)."""
+    _move_node(net, st, nodes, heaps, i, dux, theta, True)
+
+
+@kernel_jit(forceinline=True)
+def _move_node(net, st, nodes, heaps, i, dux, theta, aging):
+    """Both moves; ``aging`` is a constant of each caller. With it, node i has just slipped and drawn its
+    new threshold: its renewed contact starts there, at age 0."""
+    if aging:
+        nodes.mu0[i] = nodes.mu[i]
     nodes.u[i] += dux
     st.x_G += dux * net.w[i]
     # nonneg: the row's bounds, its entries and their nodes are indices >= 0, and numba's wrap-around
@@ -84,7 +111,7 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta):
         q = nonneg(p)  # the compiler does not carry lo >= 0 over to p
         j = nonneg(net.indices[q])
         nodes.a[j] -= net.K_data[q] * dux
-        update_node(net, nodes, heaps, j, theta, st.event_time)
+        _update_node(net, nodes, heaps, j, theta, st.event_time, aging)
 
 
 @kernel_jit(forceinline=True)
@@ -102,17 +129,31 @@ def pair_tilt(net, st, nodes, draws, out, settings):
 def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`slidernet.kernels.network.run_network` on a 1D network (``net`` a Chain)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node, no_tilt)
+                       update_node, critical_roots, slip_displacement, move_node, no_tilt, tree_event)
+
+
+@kernel_jit()
+def run_chain_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
+    """:func:`run_chain` with contact strengthening (:mod:`slidernet.kernels.strength`)."""
+    return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
+                       update_node_aging, critical_roots, slip_displacement, move_node_aging, no_tilt,
+                       strengthened_event)
 
 
 @kernel_jit()
 def run_chain_tilt(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`run_chain` with the appendix's tilt test before every rearrangement (a 2-node chain)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node, pair_tilt)
+                       update_node, critical_roots, slip_displacement, move_node, pair_tilt, tree_event)
 
 
 @kernel_jit()
 def init_chain_heaps(net, state, nodes, heaps, t):
-    """:func:`slidernet.kernels.network.init_heaps` on a 1D network, at time t (tau_th)."""
+    """:func:`slidernet.kernels.network.init_heaps` on a 1D network (t, the time, is not read)."""
     init_heaps(net, state, nodes, heaps, t, update_node)
+
+
+@kernel_jit()
+def init_chain_heaps_aging(net, state, nodes, heaps, t):
+    """:func:`init_chain_heaps` with contact strengthening: every threshold first brought up to time t (tau_th)."""
+    init_heaps(net, state, nodes, heaps, t, update_node_aging)

@@ -8,8 +8,8 @@ the slip, how a slip moves the forces -- comes in as five functions of the
 geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
 of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 
-* ``update_node(net, nodes, heaps, j, theta, t)``: re-key node j in the heap and trees (its
-  threshold first brought up to time t where contacts strengthen);
+* ``update_node(net, nodes, heaps, j, theta, t)``: re-key node j in the heap and trees (the
+  strengthening variant first brings its threshold up to time t);
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
@@ -18,7 +18,14 @@ of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
   of K, re-keying each node of the row as its force moves;
 * ``tilt(net, st, nodes, draws, out, settings)``: the appendix's tilt test
   before a rearrangement (a 1D pair, :func:`slidernet.kernels.chain.pair_tilt`)
-  or nothing (:func:`no_tilt`).
+  or nothing (:func:`no_tilt`);
+* ``driving_event(st, net, nodes, heaps, thetas, s, critical_roots)``: the
+  next driving event, the top of the driving tree (:func:`tree_event`) or,
+  with contact strengthening, the lazy exact search of
+  :func:`slidernet.kernels.strength.strengthened_event`; the variants with
+  strengthening (``run_chain_aging``, ``run_plane_aging``, ...) pass it and
+  the ``update_node`` and ``move_node`` that bring thresholds up to date, so
+  that no other kernel carries a line of it.
 
 Only the functions that take other functions are inlined into the kernel
 by numba (``inline="always"``: :func:`run_network`, :func:`slip_node`,
@@ -54,7 +61,7 @@ from slidernet.kernels.heap import (
 )
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, nonneg
-from slidernet.kernels.strength import refresh_all, strengthened_event
+from slidernet.kernels.strength import refresh_all
 
 
 @kernel_jit(inline="always")
@@ -85,8 +92,6 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
     # as moving every force first).
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
-    if nodes.mu0.size:  # strengthening: the renewed contact starts at its drawn threshold, age 0
-        nodes.mu0[i] = nodes.mu[i]
     move_node(net, st, nodes, heaps, i, dux, duy, theta)
     return True
 
@@ -167,8 +172,15 @@ def no_tilt(net, st, nodes, draws, out, settings):
 
 
 @kernel_jit(inline="always")
+def tree_event(st, net, nodes, heaps, thetas, s, critical_roots):
+    """The ``driving_event`` of thresholds that do not age: the top of the active driving tree
+    (:func:`~slidernet.kernels.heap.next_driving_event`)."""
+    return next_driving_event(st, heaps, thetas, s)
+
+
+@kernel_jit(inline="always")
 def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings, update_node,
-                critical_roots, slip_displacement, move_node, tilt):
+                critical_roots, slip_displacement, move_node, tilt, driving_event):
     """Advance a network through ``thetas`` (units of Ntilde); returns a status code.
 
     Parameters
@@ -250,10 +262,7 @@ def run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, o
             return DONE
         s = theta_direction(st, thetas)
         turn(net, nodes, heaps, s, critical_roots)
-        if nodes.mu0.size:
-            best, thc = strengthened_event(st, net, nodes, heaps, thetas, s, critical_roots)
-        else:
-            best, thc = next_driving_event(st, heaps, thetas, s)
+        best, thc = driving_event(st, net, nodes, heaps, thetas, s, critical_roots)
         if best >= 0:
             best = nonneg(best)
             st.theta = thc

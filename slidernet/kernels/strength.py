@@ -37,7 +37,7 @@ slip then starts at the threshold of the bracket's end, |F_i| = mu_s,i N_i
 to the rounding of eq. `critique`'s root, as without strengthening.
 
 Nodes a slip touches are brought up to date at the avalanche's time
-(:func:`refresh`, in each geometry's ``update_node``), so that every
+(:func:`refresh`, in each geometry's ``update_node_aging``), so that every
 stability test of an avalanche reads the threshold of that moment; at an
 output step every node is (:func:`refresh_all`), so that mu_max, mu_mean,
 mu_min and the network tilt test read the thresholds of the record's time.

@@ -170,10 +170,10 @@ class NetworkBackend:
 
     # The compiled kernel of the network's geometry and the scene's variant, and the one that builds its heaps.
     _run: Callable[..., int]
-    _init_heaps: ClassVar[Callable[..., None]]
+    _init_heaps: Callable[..., None]
 
     def rebuild_heaps(self, real: Host) -> None:
-        type(self)._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps, state_time(real))
+        self._init_heaps(self.scene.operators, real.state, self.nodes, self.heaps, state_time(real))
 
     def run(self, real: Host, thetas: np.ndarray) -> int:
         scene = self.scene
@@ -301,15 +301,21 @@ class ChainBackend(NetworkBackend):
     """Any 1D network (``solver.kernel = "csr"``): CSR rows of K, scalar forces."""
 
     kernel: ClassVar[str] = "csr"
-    _init_heaps = kernels.init_chain_heaps
 
     def __init__(self, scene: Scene, real: Host) -> None:
-        self._run = kernels.run_chain_tilt if scene.do_tilt else kernels.run_chain
+        # The appendix's test and strengthening never meet (the configuration refuses it).
+        if scene.strengthening is not None:
+            self._run, self._init_heaps = kernels.run_chain_aging, kernels.init_chain_heaps_aging
+        else:
+            self._run = kernels.run_chain_tilt if scene.do_tilt else kernels.run_chain
+            self._init_heaps = kernels.init_chain_heaps
         super().__init__(scene, real)
 
     @staticmethod
     def parts(scene: Scene) -> list[str]:
         """What this backend compiles for ``scene``, in words (the compile notice's list)."""
+        if scene.strengthening is not None:
+            return ["1D network with contact strengthening"]
         return ["1D network", "appendix's tilt test"] if scene.do_tilt else ["1D network"]
 
 
@@ -318,16 +324,22 @@ class PlaneBackend(NetworkBackend):
     along y too."""
 
     kernel: ClassVar[str] = "vec"
-    _init_heaps = kernels.init_plane_heaps
 
     def __init__(self, scene: Scene, real: Host) -> None:
-        self._run = kernels.run_plane_exact if scene.slip_mode == SLIP_EXACT else kernels.run_plane
+        exact = scene.slip_mode == SLIP_EXACT
+        if scene.strengthening is not None:
+            self._run = kernels.run_plane_exact_aging if exact else kernels.run_plane_aging
+            self._init_heaps = kernels.init_plane_heaps_aging
+        else:
+            self._run = kernels.run_plane_exact if exact else kernels.run_plane
+            self._init_heaps = kernels.init_plane_heaps
         super().__init__(scene, real)
 
     @staticmethod
     def parts(scene: Scene) -> list[str]:
         """What this backend compiles for ``scene``, in words (the compile notice's list)."""
-        return ["2D network", "exact 2D slip"] if scene.slip_mode == SLIP_EXACT else ["2D network"]
+        parts = ["2D network with contact strengthening" if scene.strengthening is not None else "2D network"]
+        return [*parts, "exact 2D slip"] if scene.slip_mode == SLIP_EXACT else parts
 
     def records(self, T: int) -> dict[str, np.ndarray]:
         return {**super().records(T), "y_G": np.zeros(T)}

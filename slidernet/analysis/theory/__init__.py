@@ -23,6 +23,14 @@ Three kinds of results live side by side and the docstrings say which is which:
   (:func:`chain_creep`, :func:`chain_creep_segments`,
   :func:`chain_critical_amplitude`).
 
+None of them holds with contact strengthening (``[friction.strengthening]``,
+docs/model.md, "Contact strengthening"): the thresholds are then draws
+raised by the age of their contact, no longer a sequence of i.i.d. draws,
+so the exact statistics of mu_max and of its records, the paper's laws
+built on them (eq. ``mumaxth``; eq. ``slope`` assumes thresholds that do
+not change between slips) and the creep of constant thresholds describe
+runs without it only.
+
 Each kind has its module, and every public name is re-exported here, so
 ``from slidernet.analysis.theory import mu_max_moments`` is the way to use
 them:
