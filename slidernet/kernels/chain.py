@@ -18,27 +18,13 @@ from slidernet.kernels.heap import heap_set, set_critical
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.network import init_heaps, no_tilt, run_network, tree_event
 from slidernet.kernels.state import UNSTABLE, nonneg
-from slidernet.kernels.strength import refresh, strengthened_event
+from slidernet.kernels.strength import refresh_all_nodes, refresh_row, strengthened_event
 from slidernet.kernels.tilt import tilt_sample
 
 
 @kernel_jit(forceinline=True)
-def update_node(net, nodes, heaps, j, theta, t):
-    """Re-key node j in the three heaps after its force or threshold changed (t, the time, is not read)."""
-    _update_node(net, nodes, heaps, j, theta, t, False)
-
-
-@kernel_jit(forceinline=True)
-def update_node_aging(net, nodes, heaps, j, theta, t):
-    """:func:`update_node` with contact strengthening: node j's threshold first brought up to time t (tau_th)."""
-    _update_node(net, nodes, heaps, j, theta, t, True)
-
-
-@kernel_jit(forceinline=True)
-def _update_node(net, nodes, heaps, j, theta, t, aging):
-    """Both re-keyings; ``aging`` is a constant of each caller, so LLVM's inlining removes the branch."""
-    if aging:
-        refresh(nodes, j, t)
+def update_node(net, nodes, heaps, j, theta):
+    """Re-key node j in the three heaps after its force or threshold changed."""
     a = nodes.a
     g = net.g
     F = abs(a[j] + g[j] * theta)
@@ -86,21 +72,6 @@ def slip_displacement(net, nodes, settings, i, theta, driving, s):
 def move_node(net, st, nodes, heaps, i, dux, duy, theta):
     """Displace node i by dux: the centre of mass, and the force offsets on the CSR row of K, each
     node of the row re-keyed (:func:`update_node`) as soon as its force is moved."""
-    _move_node(net, st, nodes, heaps, i, dux, theta, False)
-
-
-@kernel_jit(forceinline=True)
-def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
-    """:func:`move_node` with contact strengthening (:func:`update_node_aging` at the avalanche's time)."""
-    _move_node(net, st, nodes, heaps, i, dux, theta, True)
-
-
-@kernel_jit(forceinline=True)
-def _move_node(net, st, nodes, heaps, i, dux, theta, aging):
-    """Both moves; ``aging`` is a constant of each caller. With it, node i has just slipped and drawn its
-    new threshold: its renewed contact starts there, at age 0."""
-    if aging:
-        nodes.mu0[i] = nodes.mu[i]
     nodes.u[i] += dux
     st.x_G += dux * net.w[i]
     # nonneg: the row's bounds, its entries and their nodes are indices >= 0, and numba's wrap-around
@@ -111,7 +82,15 @@ def _move_node(net, st, nodes, heaps, i, dux, theta, aging):
         q = nonneg(p)  # the compiler does not carry lo >= 0 over to p
         j = nonneg(net.indices[q])
         nodes.a[j] -= net.K_data[q] * dux
-        _update_node(net, nodes, heaps, j, theta, st.event_time, aging)
+        update_node(net, nodes, heaps, j, theta)
+
+
+@kernel_jit(forceinline=True)
+def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
+    """:func:`move_node` with contact strengthening: node i's renewed contact and the thresholds of its row
+    brought up to the avalanche's time first (:func:`~slidernet.kernels.strength.refresh_row`)."""
+    refresh_row(net, nodes, i, st.event_time)
+    move_node(net, st, nodes, heaps, i, dux, duy, theta)
 
 
 @kernel_jit(forceinline=True)
@@ -134,9 +113,9 @@ def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out
 
 @kernel_jit()
 def run_chain_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
-    """:func:`run_chain` with contact strengthening (:mod:`slidernet.kernels.strength`)."""
+    """:func:`run_chain` with contact strengthening (``nodes`` an AgingNodes; see :mod:`.strength`)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node_aging, critical_roots, slip_displacement, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement, move_node_aging, no_tilt,
                        strengthened_event)
 
 
@@ -149,11 +128,12 @@ def run_chain_tilt(thetas, out_steps, net, state, nodes, heaps, draws, catalogue
 
 @kernel_jit()
 def init_chain_heaps(net, state, nodes, heaps, t):
-    """:func:`slidernet.kernels.network.init_heaps` on a 1D network (t, the time, is not read)."""
-    init_heaps(net, state, nodes, heaps, t, update_node)
+    """:func:`slidernet.kernels.network.init_heaps` on a 1D network (t, the state's time, is not read)."""
+    init_heaps(net, state, nodes, heaps, update_node)
 
 
 @kernel_jit()
 def init_chain_heaps_aging(net, state, nodes, heaps, t):
     """:func:`init_chain_heaps` with contact strengthening: every threshold first brought up to time t (tau_th)."""
-    init_heaps(net, state, nodes, heaps, t, update_node_aging)
+    refresh_all_nodes(nodes, t)
+    init_heaps(net, state, nodes, heaps, update_node)

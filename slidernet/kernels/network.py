@@ -8,8 +8,7 @@ the slip, how a slip moves the forces -- comes in as five functions of the
 geometry, from :mod:`slidernet.kernels.chain` (1D: scalar forces, CSR rows
 of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
 
-* ``update_node(net, nodes, heaps, j, theta, t)``: re-key node j in the heap and trees (the
-  strengthening variant first brings its threshold up to time t);
+* ``update_node(net, nodes, heaps, j, theta)``: re-key node j in the heap and trees;
 * ``critical_roots(net, nodes, j)``: theta_dn and theta_up of a driven node;
 * ``slip_displacement(net, nodes, settings, i, theta, driving, s)``: the
   slip of node i alone, ``(ok, du_x, du_y)``;
@@ -24,8 +23,9 @@ of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
   with contact strengthening, the lazy exact search of
   :func:`slidernet.kernels.strength.strengthened_event`; the variants with
   strengthening (``run_chain_aging``, ``run_plane_aging``, ...) pass it and
-  the ``update_node`` and ``move_node`` that bring thresholds up to date, so
-  that no other kernel carries a line of it.
+  a ``move_node`` that first brings the thresholds of the slipped node's
+  row up to date, and run on a :class:`~slidernet.kernels.state.AgingNodes`,
+  so that no other kernel carries a line of it.
 
 Only the functions that take other functions are inlined into the kernel
 by numba (``inline="always"``: :func:`run_network`, :func:`slip_node`,
@@ -61,17 +61,16 @@ from slidernet.kernels.heap import (
 )
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, nonneg
-from slidernet.kernels.strength import refresh_all
+from slidernet.kernels.strength import refresh_at_record
 
 
 @kernel_jit(inline="always")
-def init_heaps(net, state, nodes, heaps, t, update_node):
-    """(Re)build the unstable heap and the driving trees from scratch, O(N log N) at most; t is the time
-    of the state (tau_th), at which strengthening thresholds are brought up to date."""
+def init_heaps(net, state, nodes, heaps, update_node):
+    """(Re)build the unstable heap and the driving trees from scratch, O(N log N) at most."""
     st = state[0]
     heap_clear(heaps)
     for j in range(nodes.mu.size):
-        update_node(net, nodes, heaps, j, st.theta, t)
+        update_node(net, nodes, heaps, j, st.theta)
 
 
 @kernel_jit(inline="always")
@@ -121,8 +120,7 @@ def record(st, nodes, out, t):
     The contact ages are written only where the scene records them (``out.contact_age`` not 0-length);
     with strengthening every threshold is first brought up to time t.
     """
-    if nodes.mu0.size:
-        refresh_all(st, nodes, t)
+    refresh_at_record(st, nodes, t)
     if out.contact_age.size:
         write_ages(t, nodes.last_slip, out, st.next_out)
     write_output(st, nodes.mu, out)

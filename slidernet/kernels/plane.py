@@ -31,7 +31,7 @@ from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.memory import prefetch
 from slidernet.kernels.network import init_heaps, no_tilt, run_network, tree_event
 from slidernet.kernels.state import UNSTABLE, nonneg
-from slidernet.kernels.strength import refresh, strengthened_event
+from slidernet.kernels.strength import refresh_all_nodes, refresh_row, strengthened_event
 
 _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
@@ -183,22 +183,8 @@ def _acc(x, y, vx, vy, Fx, Fy, kxx, kxy, kyy, fd):
 
 
 @kernel_jit(forceinline=True)
-def update_node(net, nodes, heaps, j, theta, t):
-    """Re-key node j in the three heaps after its force or threshold changed (t, the time, is not read)."""
-    _update_node(net, nodes, heaps, j, theta, t, False)
-
-
-@kernel_jit(forceinline=True)
-def update_node_aging(net, nodes, heaps, j, theta, t):
-    """:func:`update_node` with contact strengthening: node j's threshold first brought up to time t (tau_th)."""
-    _update_node(net, nodes, heaps, j, theta, t, True)
-
-
-@kernel_jit(forceinline=True)
-def _update_node(net, nodes, heaps, j, theta, t, aging):
-    """Both re-keyings; ``aging`` is a constant of each caller, so LLVM's inlining removes the branch."""
-    if aging:
-        refresh(nodes, j, t)
+def update_node(net, nodes, heaps, j, theta):
+    """Re-key node j in the three heaps after its force or threshold changed."""
     a = nodes.a
     gx = net.g[j, 0]
     gy = net.g[j, 1]
@@ -346,21 +332,6 @@ def spread(net, a, i, dux, duy):
 def move_node(net, st, nodes, heaps, i, dux, duy, theta):
     """Displace node i by (dux, duy): the centre of mass, and the force offsets on the block row of K,
     each node of the row re-keyed (:func:`update_node`) as soon as its force is moved."""
-    _move_node(net, st, nodes, heaps, i, dux, duy, theta, False)
-
-
-@kernel_jit(forceinline=True)
-def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
-    """:func:`move_node` with contact strengthening (:func:`update_node_aging` at the avalanche's time)."""
-    _move_node(net, st, nodes, heaps, i, dux, duy, theta, True)
-
-
-@kernel_jit(forceinline=True)
-def _move_node(net, st, nodes, heaps, i, dux, duy, theta, aging):
-    """Both moves; ``aging`` is a constant of each caller. With it, node i has just slipped and drawn its
-    new threshold: its renewed contact starts there, at age 0."""
-    if aging:
-        nodes.mu0[i] = nodes.mu[i]
     nodes.u[i, 0] += dux
     nodes.u[i, 1] += duy
     # With unit loads every weight is the same 1/N: w[0], in cache, has the bits of w[i].
@@ -387,7 +358,15 @@ def _move_node(net, st, nodes, heaps, i, dux, duy, theta, aging):
         q = nonneg(p)  # lo >= 0, but the compiler does not carry that over to p
         j = nonneg(net.indices[q])
         _pushed(net, nodes.a, q, j, dux, duy)
-        _update_node(net, nodes, heaps, j, theta, st.event_time, aging)
+        update_node(net, nodes, heaps, j, theta)
+
+
+@kernel_jit(forceinline=True)
+def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
+    """:func:`move_node` with contact strengthening: node i's renewed contact and the thresholds of its row
+    brought up to the avalanche's time first (:func:`~slidernet.kernels.strength.refresh_row`)."""
+    refresh_row(net, nodes, i, st.event_time)
+    move_node(net, st, nodes, heaps, i, dux, duy, theta)
 
 
 @kernel_jit()
@@ -422,9 +401,9 @@ def run_plane_exact(thetas, out_steps, net, state, nodes, heaps, draws, catalogu
 
 @kernel_jit()
 def run_plane_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
-    """:func:`run_plane` with contact strengthening (:mod:`slidernet.kernels.strength`)."""
+    """:func:`run_plane` with contact strengthening (``nodes`` an AgingNodes; see :mod:`.strength`)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node_aging, critical_roots, slip_displacement, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement, move_node_aging, no_tilt,
                        strengthened_event)
 
 
@@ -432,17 +411,18 @@ def run_plane_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogu
 def run_plane_exact_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`run_plane_exact` with contact strengthening."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node_aging, critical_roots, slip_displacement_exact, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement_exact, move_node_aging, no_tilt,
                        strengthened_event)
 
 
 @kernel_jit()
 def init_plane_heaps(net, state, nodes, heaps, t):
-    """:func:`slidernet.kernels.network.init_heaps` on a 2D network (t, the time, is not read)."""
-    init_heaps(net, state, nodes, heaps, t, update_node)
+    """:func:`slidernet.kernels.network.init_heaps` on a 2D network (t, the state's time, is not read)."""
+    init_heaps(net, state, nodes, heaps, update_node)
 
 
 @kernel_jit()
 def init_plane_heaps_aging(net, state, nodes, heaps, t):
     """:func:`init_plane_heaps` with contact strengthening: every threshold first brought up to time t (tau_th)."""
-    init_heaps(net, state, nodes, heaps, t, update_node_aging)
+    refresh_all_nodes(nodes, t)
+    init_heaps(net, state, nodes, heaps, update_node)

@@ -47,6 +47,8 @@ from __future__ import annotations
 
 import math
 
+from numba.extending import overload
+
 from slidernet.kernels.heap import next_driving_event, set_critical
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import nonneg
@@ -79,23 +81,52 @@ def threshold_at(nodes, j, t):
 
 
 @kernel_jit(forceinline=True)
-def refresh(nodes, j, t):
-    """Bring node j's threshold up to time t (a no-op without strengthening)."""
-    if nodes.mu0.size:
+def refresh_row(net, nodes, i, t):
+    """Before node i's slip moves the forces of its row: its renewed contact starts at the threshold it has
+    just drawn (age 0), and every node of the row has its threshold brought up to time t (tau_th), the
+    avalanche's, so that its stability is tested against the threshold of that moment. ``net`` is a Chain
+    or a Plane (both keep their rows in ``indptr`` and ``indices``)."""
+    nodes.mu0[i] = nodes.mu[i]
+    for p in range(nonneg(net.indptr[i]), nonneg(net.indptr[i + 1])):
+        j = nonneg(net.indices[nonneg(p)])
+        nodes.mu[j] = threshold_at(nodes, j, t)
+
+
+@kernel_jit()
+def refresh_all_nodes(nodes, t):
+    """Bring every threshold up to time t (tau_th), O(N): when the heaps are rebuilt."""
+    for j in range(nodes.mu.size):
         nodes.mu[j] = threshold_at(nodes, j, t)
 
 
 @kernel_jit()
 def refresh_all(st, nodes, t):
     """Bring every threshold up to time t, and mu_max and its holder with them, O(N): at output steps."""
+    refresh_all_nodes(nodes, t)
     mu = nodes.mu
     best = 0
     for j in range(mu.size):
-        mu[j] = threshold_at(nodes, j, t)
         if mu[j] > mu[best]:
             best = j
     st.mu_max = mu[best]
     st.argmax = best
+
+
+def refresh_at_record(st, nodes, t):
+    """At an output step: :func:`refresh_all` where ``nodes`` is an AgingNodes, nothing for Nodes (compiled
+    per type by numba, :func:`_refresh_at_record`: a kernel without strengthening carries no line of it)."""
+
+
+@overload(refresh_at_record, jit_options={"cache": True})
+def _refresh_at_record(st, nodes, t):
+    if "mu0" in getattr(nodes, "fields", ()):
+        def impl(st, nodes, t):
+            refresh_all(st, nodes, t)
+        return impl
+
+    def nothing(st, nodes, t):
+        pass
+    return nothing
 
 
 @kernel_jit(inline="always")

@@ -139,16 +139,17 @@ class NetworkBackend:
         g = scene.operators.g
         strong = scene.strengthening is not None
         # a = F - theta g with u = 0: every spring at rest at theta(0), plus the external load.
-        self.nodes = kernels.Nodes(a=-g * real.thetas[0] + self._f_ext(), u=np.zeros_like(g), mu=real.mu,
-                                   node_slips=np.zeros(N, np.int64),
-                                   avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64),
-                                   # Read only where the scene can slide away: 0-length elsewhere.
-                                   moving=np.full(N if scene.slide_away else 0, -1, np.int64),
-                                   # Read and written only where the scene records contact_age or its
-                                   # contacts strengthen.
-                                   last_slip=np.zeros(N if scene.contact_age or strong else 0),
-                                   mu0=real.mu.copy() if strong else np.zeros(0),
-                                   law=np.array(scene.strengthening if strong else (), np.float64))
+        fields = dict(a=-g * real.thetas[0] + self._f_ext(), u=np.zeros_like(g), mu=real.mu,
+                      node_slips=np.zeros(N, np.int64),
+                      avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64),
+                      # Read only where the scene can slide away: 0-length elsewhere.
+                      moving=np.full(N if scene.slide_away else 0, -1, np.int64),
+                      # Read and written only where the scene records contact_age or its contacts strengthen.
+                      last_slip=np.zeros(N if scene.contact_age or strong else 0))
+        # With strengthening, the type the *_aging kernels are compiled for: its drawn thresholds and its law.
+        self.nodes: kernels.Nodes | kernels.AgingNodes = (
+            kernels.AgingNodes(**fields, mu0=real.mu.copy(), law=np.array(scene.strengthening, np.float64))
+            if strong else kernels.Nodes(**fields))
         # The unstable heap, and the driving trees over the driven nodes (g_i != 0).
         self.heaps = kernels.Heaps.empty(1, N, driven=np.any(g.reshape(N, -1) != 0.0, axis=1))
         # The event catalogue: the kernel fills a buffer of EVENT_CHUNK rows (fewer where
