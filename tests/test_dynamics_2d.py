@@ -56,8 +56,9 @@ def test_single_slider_slips_along_its_force(angle: float) -> None:
 
     theta rises by Ntilde per tau_th (the ramp) and tau_dyn / tau_th = 1e-9, so theta moves the force by
     ~3e-9 N during the slip: the slip is eq. `displacement`'s to that, and the stop comes ~1e-5 tau_dyn
-    early (STOP_SPEED over the deceleration 0.1): tolerances 1e-6 relative on the length (its error is
-    ~1e-8) and on the duration, 1e-6 rad on the direction, and |F_0| = mu_s N_0 at the start to 1e-12.
+    early (STOP_SPEED over the deceleration 0.1): tolerances 1e-6 relative on the length (measured
+    2e-8), 1e-5 on the duration (measured -3.4e-6), 1e-6 rad on the direction, and |F_0| = mu_s N_0 at
+    the start to 1e-12.
     """
     sc = scene(3, network=corner(angle), driver={"name": "ramp", "rate": Ntilde})
     seed = np.random.SeedSequence(4)
@@ -76,8 +77,9 @@ def test_single_slider_slips_along_its_force(angle: float) -> None:
     length = 2.0 * (mu_s - MU_D)
     assert np.hypot(*du) == pytest.approx(length, rel=1e-6)
     assert abs(math.atan2(F[0] * du[1] - F[1] * du[0], F @ du)) < 1e-6
-    assert slip["duration"] == pytest.approx(math.pi * tau, rel=1e-6)
-    assert out["stop_speed"] == pytest.approx(STOP_SPEED * Ntilde, rel=1e-6)  # the event's root
+    # The stop comes STOP_SPEED / 0.1 = 1e-5 tau_dyn early (3.4e-6 of pi, measured): tolerance 1e-5.
+    assert slip["duration"] / tau == pytest.approx(math.pi, rel=1e-5)
+    assert out["stop_speed"] / Ntilde == pytest.approx(STOP_SPEED, rel=1e-6)  # the event's root
 
 
 SQUARE = Network([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], [[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]],

@@ -54,8 +54,9 @@ peaks at ~0.1), so the stop comes ~1e-5 tau_dyn and ~STOP_SPEED^2 / 0.2 ~
 5e-12 Ntilde l0 early: 2.5e-11 of a slip of length 0.2. The nodes that start
 in a phase are watched by an event of their own (their speed rises through
 STOP_SPEED first, which a falling event ignores). On the isolated slip of a
-slider with an isotropic spring the length and duration are exact to 1e-6
-(tests/test_dynamics_2d.py).
+slider with an isotropic spring (tests/test_dynamics_2d.py) the length is
+eq. `displacement`'s to 2e-8 and the duration pi tau_dyn less 3.4e-6 of it,
+the early stop.
 
 Cost: about 21 ms per slip at the defaults (DOP853, max_step = 0.05 tau_dyn,
 ~66 steps per slip), 15 ms with RK45, 7 ms at max_step = 0.2 and 4 ms at
