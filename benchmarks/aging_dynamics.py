@@ -40,8 +40,8 @@ in 2D::
     PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --geometry irregular --sizes 16 --steps 10 \
         --out aging_dynamics_2d_16.json
 
-They cost far more: ~280 slips per tau_th at 16 sliders and ~15 ms of CPU each, so 16 realizations
-to 30 tau_th take ~35 CPU-minutes at 16 sliders and several CPU-hours at 64. The JSON is written
+They cost far more: ~280 slips per tau_th at 16 sliders and ~14 ms of CPU each, so 16 realizations
+to 30 tau_th take ~30 CPU-minutes at 16 sliders and several CPU-hours at 64. The JSON is written
 after every realization with those done so far (``realizations_done``), so a run cut short keeps
 them; ``--from-json`` prints its tables. ``--rate-check R`` instead
 tests the states of the first R realizations at ten times and a tenth of the ramp rate, the
