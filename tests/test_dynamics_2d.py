@@ -106,10 +106,10 @@ def test_four_equal_unstressed_sliders_slide_at_mu_s(rate: float) -> None:
 
 # -- the quasi-static limit: the solver's exact 2D slip (solver.slip = "exact") ----------------------------
 
-def irregular_8(steps: int, sigma: float) -> Scene:
-    """The study's irregular network of 8 (network seed 0), exact 2D slips, sigma_theta = sigma Ntilde."""
+def irregular_8(steps: int, sigma: float, slip: str = "exact") -> Scene:
+    """The study's irregular network of 8 (network seed 0), slip rule ``slip``, sigma_theta = sigma Ntilde."""
     return scene(steps, net={"kind": "irregular", "n": 8, "seed": 0, "Ntilde": Ntilde},
-                 driver={"name": "gaussian_steps", "sigma_theta": sigma * Ntilde}, solver={"slip": "exact"},
+                 driver={"name": "gaussian_steps", "sigma_theta": sigma * Ntilde}, solver={"slip": slip},
                  observables=["n", "mu_max", "x_G"])
 
 
@@ -120,14 +120,21 @@ def test_isolated_slips_are_the_solvers_exact_slip() -> None:
     moves alone under Coulomb friction along its velocity, its neighbours held, is the solver's exact 2D
     slip (kernels.plane.exact_slip), so n and the thresholds (mu_max) are the solver's at every step and
     x_G agrees to the slips' error: measured max |dx_G| / rms(x_G) = 1.3e-7; tolerance 1e-5.
+
+    The default straight-line slip (kernels.plane.run_plane) is not that limit: K_ii of these nodes is
+    anisotropic (eigenvalue ratios 1.3 to 5.5), so a slip curves and its length differs. Measured: x_G
+    off by 0.12 rms, and n by one slip from step 9 on; asserted: off by more than 1e-2 rms.
     """
     sc = irregular_8(10, 0.3)
     out = Dynamics(sc, tau_ratio=1e-9).run(np.random.SeedSequence(3))
     ref = simulate(sc, np.random.SeedSequence(3))
+    rms = np.sqrt(np.mean(ref["x_G"] ** 2))
     assert out["overlapping"] == 0
     assert np.array_equal(out["n"], ref["n"])
     assert np.array_equal(out["mu_max"], ref["mu_max"])
-    assert np.abs(out["x_G"] - ref["x_G"]).max() < 1e-5 * np.sqrt(np.mean(ref["x_G"] ** 2))
+    assert np.abs(out["x_G"] - ref["x_G"]).max() < 1e-5 * rms
+    straight = simulate(irregular_8(10, 0.3, "straight"), np.random.SeedSequence(3))
+    assert np.abs(out["x_G"] - straight["x_G"]).max() > 1e-2 * rms
 
 
 def test_overlapping_slips_depart_from_the_solver() -> None:

@@ -520,9 +520,9 @@ class _Realization:
 
     Attributes: ``u`` (N d,) displacements in Ntilde l0, node-major; ``v``
     (N d,) velocities in Ntilde l0 per tau_dyn; ``moving`` (N,) bool;
-    ``sigma`` (N d,) the unit direction of motion of each moving node (the
-    sign of its velocity in 1D; in 2D its direction at the start of the
-    phase, see the module's "How it is integrated"); ``t`` the time in
+    ``sigma`` (N d,) the unit direction of F_i when node i started: in 1D
+    the sign of its motion; in 2D the direction of its friction while
+    v_i = 0 (see the module's "How it is integrated"); ``t`` the time in
     tau_th; ``clock`` the time spent in motion, in tau_dyn (it also runs
     during the relaxation at t = 0, where theta is frozen).
     """
@@ -711,8 +711,8 @@ class _Realization:
         N per tau_dyn) is g dtheta/ds when theta drives, f' N_i x when a tilt
         f(s) does (:meth:`tilt`). Updates u and v of the moving nodes and
         ``clock``; returns the time elapsed (tau_dyn) and the event,
-        ``"stop"`` (a velocity's component along its direction ``sigma``
-        fell to zero: a stop, or in 2D a turn), ``"start"`` or None.
+        ``"stop"`` (in 1D v_i sigma_i fell to zero; in 2D |v_i| fell to
+        STOP_SPEED), ``"start"`` or None.
         """
         d = self.d
         dim = d.dim
