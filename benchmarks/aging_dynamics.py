@@ -33,7 +33,17 @@ Run from the repository root::
 
     PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --realizations 16 --steps 30 --out aging_dynamics.json
 
-(about 5 min on one core; T = 100 takes about three times longer). ``--rate-check R`` instead
+(about 5 min on one core; T = 100 takes about three times longer). With ``--geometry irregular`` the
+sizes are the study's irregular 2D networks (network seed 0, the base point's geometry 0), integrated
+in 2D::
+
+    PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --geometry irregular --sizes 16 --steps 10 \
+        --out aging_dynamics_2d_16.json
+
+They cost far more: ~280 slips per tau_th at 16 sliders and ~14 ms of CPU each, so 16 realizations
+to 30 tau_th take ~30 CPU-minutes at 16 sliders and several CPU-hours at 64. The JSON is written
+after every realization with those done so far (``realizations_done``), so a run cut short keeps
+them; ``--from-json`` prints its tables. ``--rate-check R`` instead
 tests the states of the first R realizations at ten times and a tenth of the ramp rate, the
 effect of the rate on the dynamic tilt test (``--rate-check 4 --sizes 3 4``: about 2 min).
 """
@@ -69,10 +79,15 @@ MU_D = 0.5
 KEY_DYN, KEY_QS, KEY_QS_U = 3, 4, 5
 
 
-def config(n: int, steps: int, realizations: int, seed: int) -> dict[str, Any]:
-    """The study's base point (examples/aging_networks.toml) for a chain of n (the pair kernel for n = 2)."""
+def config(n: int, steps: int, realizations: int, seed: int, geometry: str = "chain",
+           network_seed: int = 0) -> dict[str, Any]:
+    """The study's base point (examples/aging_networks.toml) for a chain of n (the pair kernel for n = 2)
+    or, with ``geometry = "irregular"``, the study's irregular 2D network of n sliders built from
+    ``network_seed`` (examples/aging_networks.py: geometry 0 of the base point has seed 1, network seed 0)."""
     network: dict[str, Any] = {"kind": "two_slider", "Ntilde": NTILDE}
-    if n != 2:
+    if geometry == "irregular":
+        network = {"kind": "irregular", "n": n, "seed": network_seed, "Ntilde": NTILDE}
+    elif n != 2:
         network = {"kind": "chain", "n": n, "Ntilde": NTILDE}
     return {
         "seed": seed, "realizations": realizations, "steps": steps, "record": "log", "log_points_per_decade": 2,
@@ -85,9 +100,10 @@ def config(n: int, steps: int, realizations: int, seed: int) -> dict[str, Any]:
 
 
 def qs_tilt(scene: Scene, F: np.ndarray, mu_s: np.ndarray, seed: int, key: tuple[int, ...]) -> float:
-    """The quasi-static network tilt test (Realization.tilt_test's kernel and rule) on a given 1D state.
+    """The quasi-static network tilt test (Realization.tilt_test's kernel and rule) on a given state.
 
-    F: forces on the nodes before the tilt, shape (N,), in N; mu_s: thresholds, shape (N,). Redrawn
+    F: forces on the nodes before the tilt, shape (N,) in 1D or (N, 2) in 2D, in N; mu_s: thresholds,
+    shape (N,). Redrawn
     thresholds come from ``TruncatedStream(scene's law, SeedSequence(seed, spawn_key=key + (KEY_QS,)))``
     and the pair rule's uniforms from ``key + (KEY_QS_U,)`` (keys rearranged below as (r, slot, k)).
     """
@@ -101,7 +117,7 @@ def qs_tilt(scene: Scene, F: np.ndarray, mu_s: np.ndarray, seed: int, key: tuple
         stream = TruncatedStream(scene.distribution, rng)
         uniforms = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r, KEY_QS_U, k))).random(size)
         G = np.zeros((N, 2))
-        G[:, 0] = F
+        G[:, :F.size // N] = F.reshape(N, -1)
         pos = np.zeros(N_POS, np.int64)
         loads = np.zeros(N_LOADS)
         f = o.test(G, mu_s.copy(), o.f_ext, o.f_bar, o.net, scene.settings(), o.pair_rule,
@@ -116,25 +132,31 @@ def qs_tilt(scene: Scene, F: np.ndarray, mu_s: np.ndarray, seed: int, key: tuple
 
 
 def summary(values: np.ndarray, t: np.ndarray, T: int) -> dict[str, Any]:
-    """Mean +- SE over realizations at t = 0, 1, T, and the slope per decade (log_trend) with its SE.
+    """Mean +- SE over realizations at t = 0, 1, 3, 10, 30 and T (those recorded), and the slope per
+    decade (log_trend over 1 <= t <= T, when it has two times or more) with its SE.
 
     values: shape (R, len(t)).
     """
     def at(time: int) -> tuple[float, float]:
         return mean_sem(values[:, int(np.flatnonzero(t == time)[0])])[:2]
 
-    trend = log_trend(xr.DataArray(values, dims=("realization", "t"), coords={"t": t.astype(float)}))
-    ln10 = math.log(10.0)
-    out: dict[str, Any] = {f"t{time}": at(time) for time in (0, 1, T)}
-    out["slope_per_decade"] = (float(trend["slope_mean"]) * ln10, float(trend["slope_sem"]) * ln10)
-    out["realizations_fitted"] = int(trend["realizations"])
+    out: dict[str, Any] = {f"t{time}": at(time) for time in (0, 1, 3, 10, 30, T) if time in t}
+    out["slope_per_decade"] = (math.nan, math.nan)
+    out["realizations_fitted"] = 0
+    if np.sum(t >= 1) >= 2:
+        trend = log_trend(xr.DataArray(values, dims=("realization", "t"), coords={"t": t.astype(float)}))
+        ln10 = math.log(10.0)
+        out["slope_per_decade"] = (float(trend["slope_mean"]) * ln10, float(trend["slope_sem"]) * ln10)
+        out["realizations_fitted"] = int(trend["realizations"])
     out["values"] = values.tolist()
     return out
 
 
-def measure(n: int, args: argparse.Namespace) -> dict[str, Any]:
+def measure(n: int, args: argparse.Namespace, done: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    """The three-way comparison at size n. After each realization the JSON is written with the
+    realizations done so far (the sizes in ``done`` first), so a run cut short keeps them."""
     R, T, seed = args.realizations, args.steps, args.seed
-    cfg = config(n, T, R, seed)
+    cfg = config(n, T, R, seed, args.geometry, args.network_seed)
     clock = time.perf_counter()
     ds = slidernet.run(cfg)
     qs_seconds = time.perf_counter() - clock
@@ -171,16 +193,29 @@ def measure(n: int, args: argparse.Namespace) -> dict[str, Any]:
         if args.progress:
             elapsed = time.perf_counter() - clock
             print(f"  n={n} r={r} slips={slips[r]} {elapsed:.1f} s", file=sys.stderr, flush=True)
+        if r >= 1 and r < R - 1:
+            part = reduce(n, args, ds, t, qs, {key: v[:r + 1] for key, v in vals.items()}, slips[:r + 1],
+                          {"qs_run": qs_seconds, "dynamics": dyn_seconds, "tilt_tests": tilt_seconds})
+            write(args, [*(done or []), part], time.perf_counter() - args.start)
+    return reduce(n, args, ds, t, qs, vals, slips,
+                  {"qs_run": qs_seconds, "dynamics": dyn_seconds, "tilt_tests": tilt_seconds})
+
+
+def reduce(n: int, args: argparse.Namespace, ds: xr.Dataset, t: np.ndarray, qs: np.ndarray,
+           vals: dict[str, np.ndarray], slips: np.ndarray, seconds: dict[str, float]) -> dict[str, Any]:
+    """The statistics of the realizations in ``vals`` (the first R' of the run, paired with the same of (i))."""
+    T = args.steps
+    R = slips.size
     result = {
-        "n": n, "t": t.tolist(),
-        "seconds": {"qs_run": qs_seconds, "dynamics": dyn_seconds, "tilt_tests": tilt_seconds},
+        "n": n, "geometry": args.geometry, "t": t.tolist(), "realizations_done": R,
+        "seconds": seconds,
         "dynamics_slips_per_tau_th": float(slips.mean() / T),
-        "qs_slips_per_tau_th": float(ds["n"].transpose("realization", "t").values[:, -1].mean() / T),
-        "qs": summary(qs, t, T),
-        "qs_first_slip": summary(ds["tilt_first_slip"].transpose("realization", "t").values, t, T),
-        "qs_all_moving": summary(ds["tilt_all_moving"].transpose("realization", "t").values, t, T),
+        "qs_slips_per_tau_th": float(ds["n"].transpose("realization", "t").values[:R, -1].mean() / T),
+        "qs": summary(qs[:R], t, T),
+        "qs_first_slip": summary(ds["tilt_first_slip"].transpose("realization", "t").values[:R], t, T),
+        "qs_all_moving": summary(ds["tilt_all_moving"].transpose("realization", "t").values[:R], t, T),
     }
-    for key in keys:
+    for key in vals:
         result[key] = summary(vals[key], t, T)
     # The certified load exceeds mu_eff by the ramp during the final motion; the largest excess over all tests.
     result["max_certified_minus_mu_eff"] = float(np.nanmax(vals["dyn_certified"] - vals["dyn_tilt"]))
@@ -197,7 +232,7 @@ def rate_check(n: int, args: argparse.Namespace) -> dict[str, Any]:
     of mu_eff, all_moving and certified against the test at ``rate``: each realization's mean over its
     records, then mean +- SE over the R realizations, and the largest |difference| of any test.
     """
-    cfg = config(n, args.steps, args.realizations, args.seed)
+    cfg = config(n, args.steps, args.realizations, args.seed, args.geometry, args.network_seed)
     dyn = Dynamics(Scene.from_config(load_config(cfg)), tau_ratio=args.tau_ratio, max_step=args.max_step)
     seeds = realization_seeds(args.seed, args.realizations)
     rates = (10 * args.rate, args.rate, args.rate / 10)
@@ -260,8 +295,10 @@ def fmt(pair: tuple[float, float], digits: int = 4) -> str:
 
 
 def table(results: list[dict[str, Any]], T: int) -> str:
-    rows = ["| N | estimator | μ_eff(0) | μ_eff(1) | μ_eff(T) | dμ_eff/dlog10 t (1e−4) |",
-            "|---|---|---|---|---|---|"]
+    times = [time for time in (0, 1, 3, 10, 30, T) if f"t{time}" in results[0]["qs"]]
+    times = sorted(set(times))
+    rows = ["| N | estimator | " + " | ".join(f"μ_eff({time})" for time in times) + " | dμ_eff/dlog10 t (1e−4) |",
+            "|---|---|" + "---|" * len(times) + "---|"]
     names = {"qs": "(i) QS run", "qs_tilt": "(ii) QS tilt on dyn. state", "dyn_tilt": "(iii) dynamic tilt",
              "dyn_first_start": "(iii) first start", "dyn_all_moving": "(iii) all moving",
              "dyn_certified": "(iii) certified", "qs_first_slip": "(i) first slip",
@@ -270,8 +307,8 @@ def table(results: list[dict[str, Any]], T: int) -> str:
         for key, name in names.items():
             s = res[key]
             slope = s["slope_per_decade"]
-            rows.append(f"| {res['n']} | {name} | {fmt(s['t0'])} | {fmt(s['t1'])} | {fmt(s[f't{T}'])} | "
-                        f"{slope[0] * 1e4:+.1f} ± {slope[1] * 1e4:.1f} |")
+            cells = " | ".join(fmt(s[f"t{time}"]) for time in times)
+            rows.append(f"| {res['n']} | {name} | {cells} | {slope[0] * 1e4:+.1f} ± {slope[1] * 1e4:.1f} |")
     return "\n".join(rows)
 
 
@@ -283,6 +320,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--max-step", type=float, default=0.05, help="Dynamics' max_step, tau_dyn")
     parser.add_argument("--rate", type=float, default=TILT_RATE, help="dynamic tilt ramp, per tau_dyn")
     parser.add_argument("--sizes", type=int, nargs="+", default=[2, 3, 4])
+    parser.add_argument("--geometry", choices=("chain", "irregular"), default="chain",
+                        help="chains (1D; the pair for size 2) or the study's irregular 2D networks")
+    parser.add_argument("--network-seed", type=int, default=0, help="the irregular network's seed")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", default="aging_dynamics.json")
     parser.add_argument("--progress", action="store_true")
@@ -312,16 +352,24 @@ def main(argv: list[str] | None = None) -> None:
             res["compare"] = compare(res)
         report(doc)
         return
-    start = time.perf_counter()
-    results = [measure(n, args) for n in args.sizes]
-    wall = time.perf_counter() - start
+    start = args.start = time.perf_counter()
+    results: list[dict[str, Any]] = []
+    for n in args.sizes:
+        results.append(measure(n, args, results))
+        wall = time.perf_counter() - start
+        doc = write(args, results, wall)
+    report(doc)
+
+
+def write(args: argparse.Namespace, results: list[dict[str, Any]], wall: float) -> dict[str, Any]:
+    """Write the JSON of the sizes done so far (after each size: a long run keeps what it has)."""
     doc = {"parameters": {**vars(args), "mu_d": MU_D, "mu_s_mean": 0.6, "mu_s_std": 0.01, "Ntilde": NTILDE,
                           "sigma_theta": NTILDE, "record": "log", "log_points_per_decade": 2},
            "command": " ".join(sys.argv), "wall_seconds": wall, "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
            "python": platform.python_version(), "slidernet": slidernet.__version__, "results": results}
     with open(args.out, "w") as fh:
         json.dump(doc, fh, indent=1)
-    report(doc)
+    return doc
 
 
 def report(doc: dict[str, Any]) -> None:

@@ -233,12 +233,6 @@ def test_bad_settings(kwargs: dict[str, Any], match: str) -> None:
         Dynamics(scene(1), **kwargs)
 
 
-def test_2d_network_is_refused() -> None:
-    sc = scene(1, network={"kind": "triangular", "shape": [2, 2], "Ntilde": Ntilde})
-    with pytest.raises(ConfigError, match="Dynamics integrates 1D networks only; the scene's network is 2D"):
-        Dynamics(sc, tau_ratio=1e-3)
-
-
 def test_bad_steps() -> None:
     with pytest.raises(ConfigError, match=r"'steps' parameter of Dynamics\.run must be an integer in \[0, 1\]"):
         Dynamics(scene(1), tau_ratio=1e-3).run(np.random.SeedSequence(0), steps=2)

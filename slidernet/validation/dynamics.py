@@ -4,14 +4,16 @@ The solver (:mod:`slidernet.solver`) makes every slip instantaneous and lets
 the slipping node move alone. Here the sliders have inertia: node i has mass
 m_i = N_i m, and while it moves
 
-    m_i d^2u_i/dt^2 = F_i(u, theta(t)) - mu_d N_i S(du_i/dt),    F = -K u + theta g + f_ext,
+    m_i d^2u_i/dt^2 = F_i(u, theta(t)) - mu_d N_i v_i / |v_i|,    F = -K u + theta g + f_ext,
 
-with theta(t) linear between theta(t_q) and theta(t_q+1), the same driver
-values as the solver's. A stuck node has du_i/dt = 0 while |F_i| <= mu_s,i N_i
-and starts, with the sign of F_i, when |F_i| reaches mu_s,i N_i, whatever the
-other nodes do: several nodes may move at once. A moving node whose velocity
-returns to zero has reached a new place on the substrate: its threshold is
-redrawn, and it sticks if |F_i| <= mu_s,i N_i, otherwise it starts again (a
+with v_i = du_i/dt (a number in 1D, where v_i / |v_i| is its sign; a vector
+in 2D, where Coulomb friction acts against the velocity) and theta(t) linear
+between theta(t_q) and theta(t_q+1), the same driver values as the solver's.
+A stuck node has v_i = 0 while |F_i| <= mu_s,i N_i and starts, along F_i,
+when |F_i| reaches mu_s,i N_i, whatever the other nodes do: several nodes may
+move at once. A moving node whose velocity returns to zero has reached a new
+place on the substrate: its threshold is redrawn (the solver's order of
+draws), and it sticks if |F_i| <= mu_s,i N_i, otherwise it starts again (a
 new rearrangement, as in the solver's 1D rule). One rearrangement is counted
 per start of motion.
 
@@ -24,29 +26,54 @@ is a half-oscillation of duration pi tau_dyn and length 2 (mu_s - mu_d) N / k
 Units are the solver's: u in Ntilde l0, theta / Ntilde, forces in N, K in
 k0 = N / (Ntilde l0), time in tau_th; during motion the integration runs in
 the local time s = (t - t_0) / tau_dyn, in which the equation of node i reads
-N_i d^2u_i/ds^2 = F_i - mu_d N_i S(du_i/ds) and every number is of order one.
+N_i d^2u_i/ds^2 = F_i - mu_d N_i v_i / |v_i| and every number is of order one.
+In 2D, u, v, F and g are node-major vectors of length 2N (component c of
+node i at 2 i + c) and K is the network's, in 2 x 2 blocks.
 
 How it is integrated
 --------------------
-Between two events the set of moving nodes and the signs of their velocities
-are fixed and theta is linear in time, so the equations are linear with a
-smooth right-hand side: each such phase is one call of
-:func:`scipy.integrate.solve_ivp` with two terminal events, the smallest
-velocity of a moving node (along its direction of motion) falling to zero,
-and the largest |F_j| - mu_s,j N_j of the stuck nodes rising to zero. A phase
-where nothing moves has u constant and F_j linear in t, so its first threshold
-crossing is found in closed form (the solver's eq. `critique`), with no steps.
+Between two events the set of moving nodes is fixed and theta is linear in
+time. In 1D the signs of the velocities are fixed too, so the equations are
+linear with a smooth right-hand side; in 2D the friction -mu_d N_i v_i/|v_i|
+is the one nonlinear term, smooth while |v_i| > 0 (a node that starts has
+v_i = 0 and its friction points against F_i, the direction it starts in).
+Each such phase is one call of :func:`scipy.integrate.solve_ivp` with
+terminal events: a moving node stops, or the largest |F_j| - mu_s,j N_j of
+the stuck nodes rises to zero. A phase where nothing moves has u constant
+and F_j linear in t, so its first threshold crossing is found in closed form
+(the solver's eq. `critique`; in 2D the root of a quadratic), with no steps.
+
+**The stop.** In 1D it is the root of v_i S_i (S_i the sign of the motion),
+exact: the friction keeps its sign past the root, so the solution crosses it
+cleanly. In 2D v_i / |v_i| is singular at the stop and the steps beyond it
+chatter about v_i = 0 (a root of v_i . S_i is not reliably crossed), so a
+node stops when its speed |v_i| falls to ``STOP_SPEED`` = 1e-6 Ntilde l0 per
+tau_dyn, and v_i is then set to 0. Near a stop |F_i| < mu_d N_i and the node
+decelerates at (mu_d N_i - |F_i|) / N_i ~ 0.1 per tau_dyn (a slip of the paper
+peaks at ~0.1), so the stop comes ~1e-5 tau_dyn and ~STOP_SPEED^2 / 0.2 ~
+5e-12 Ntilde l0 early: 2.5e-11 of a slip of length 0.2. The nodes that start
+in a phase are watched by an event of their own (their speed rises through
+STOP_SPEED first, which a falling event ignores). On the isolated slip of a
+slider with an isotropic spring (tests/test_dynamics_2d.py) the length is
+eq. `displacement`'s to 2e-8 and the duration pi tau_dyn less 3.4e-6 of it,
+the early stop.
 
 Cost: about 21 ms per slip at the defaults (DOP853, max_step = 0.05 tau_dyn,
 ~66 steps per slip), 15 ms with RK45, 7 ms at max_step = 0.2 and 4 ms at
 max_step = inf, on the paper's two sliders and on a chain of 4 alike (577 and
-160 slips, tau_ratio = 1e-4, one core): the time is scipy's, per step.
+160 slips, tau_ratio = 1e-4, one core): the time is scipy's, per step. In 2D,
+on the study's irregular networks (benchmarks/aging_dynamics.py, defaults,
+tau_ratio = 1e-4, one shared core), about 14 ms of CPU per slip at 16 and at
+64 sliders (44,674 slips of 16 realizations to 10 tau_th, and 26,895 to
+1 tau_th): those networks slip 279 times per tau_th at 16 sliders and 1,681
+times in the first tau_th at 64. A dynamic tilt test of the 64-slider network
+at t = 1 takes ~17 s of CPU (its final motion sets every slider moving).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -78,6 +105,11 @@ TILT_MAX_AVALANCHE = 1e5
 # atol = ATOL_SCALE * rtol, in Ntilde l0 (and Ntilde l0 per tau_dyn): a slip of
 # the paper is 2 (mu_s - mu_d) ~ 0.2 Ntilde l0 long, its peak velocity ~ 0.1.
 ATOL_SCALE = 1e-2
+
+# 2D: a moving node stops when its speed |v_i| falls to this, in Ntilde l0 per tau_dyn (module
+# docstring): a slip of the paper peaks at ~0.1 and decelerates at ~0.1 per tau_dyn, so the stop comes
+# ~1e-5 tau_dyn and ~5e-12 Ntilde l0 early, and the integration's own error in v is ~1e-9.
+STOP_SPEED = 1e-6
 
 
 class ThresholdStream:
@@ -116,7 +148,7 @@ def realization_draws(scene: Scene, seed_seq: np.random.SeedSequence) -> tuple[n
 
 
 class Dynamics:
-    """Reference integrator of the equations of motion (eq. `dynamics`) on a 1D network.
+    """Reference integrator of the equations of motion (eq. `dynamics`) on a 1D or 2D network.
 
     Constructing it validates and stores the settings; :meth:`run` integrates
     one realization, with the same theta(t_q) and the same stream of mu_s
@@ -125,9 +157,10 @@ class Dynamics:
     Parameters
     ----------
     scene : Scene
-        A scene of a 1D network (``two_slider``, ``chain`` or any 1D
-        :class:`~slidernet.model.network.Network`), with its f_ext, normal loads,
-        thresholds law and driver.
+        A scene of a network (``two_slider``, ``chain``, ``irregular``, a
+        lattice or any :class:`~slidernet.model.network.Network`, 1D or 2D),
+        with its f_ext, normal loads, thresholds law and driver. Dense
+        operators: meant for tens of sliders (2N = 128 for 64 in 2D).
     tau_ratio : float
         tau_dyn / tau_th, > 0, with tau_dyn = sqrt(m / k) the period of the
         reference spring divided by 2 pi (masses m_i = N_i m).
@@ -182,25 +215,23 @@ class Dynamics:
         if method not in METHODS:
             raise param_error("method", owner, f"one of {', '.join(METHODS)}", method)
         net = scene.network
-        if net.dim != 1:
-            raise ConfigError(
-                f"Dynamics integrates 1D networks only; the scene's network is {net.dim}D "
-                f"({net!r}). Compare 2D networks through the solver's slip options (solver.slip)."
-            )
         self.scene = scene
         self.tau_ratio = float(tau_ratio)
         self.max_step = float(max_step)
         self.rtol = float(rtol)
         self.atol = ATOL_SCALE * self.rtol
         self.method = method
-        # Dense operators: the networks integrated here are small (N <= ~16),
-        # and a dense sub-block product is the cheapest right-hand side.
+        self.dim = net.dim
+        # Dense operators, node-major (component c of node i at i d + c): the networks
+        # integrated here are small (N d <= ~128), and a dense sub-block product is the
+        # cheapest right-hand side.
         self.K = net.stiffness_matrix().toarray()
-        self.g = np.asarray(scene.operators.g, dtype=np.float64)
+        self.g = np.asarray(scene.operators.g, dtype=np.float64).reshape(-1)
         self.normal_load = net.normal_load.astype(np.float64)
         self.w = self.normal_load / self.normal_load.sum()
-        self.f_ext = net.f_ext[:, 0].astype(np.float64)
-        self._modes: tuple[np.ndarray, np.ndarray] | None = None  # the tilt test's, built on first use
+        self.f_ext = net.f_ext.astype(np.float64).reshape(-1)
+        self._modes: tuple[np.ndarray, np.ndarray] | None = None  # the 1D tilt test's, built on first use
+        self._compliance: np.ndarray | None = None  # the 2D tilt test's K^+, built on first use
 
     def run(self, seed_seq: np.random.SeedSequence, steps: int | None = None, *,
             states: bool = False) -> dict[str, np.ndarray]:
@@ -222,22 +253,26 @@ class Dynamics:
         dict
             ``t`` (int64, tau_th), ``n`` (int64: rearrangements, one per
             start of motion), ``mu_max``, ``x_G`` (l0, the mass-weighted mean
-            displacement), each of shape (T,), at the scene's recorded times
-            up to ``steps``; ``overlapping`` (int64 scalar: starts while another
-            node was moving); ``moving_at_end`` (int64 scalar: nodes still
-            moving at t = steps); ``slips``, a dict of arrays of shape (S,),
-            one per slip that came to rest by t = ``steps``, in the order they
-            ended: ``start`` and ``end`` (tau_th), ``duration`` (tau_th,
-            computed in the integrator's local time, so exact even where
-            ``start`` is large), ``node`` (int64), ``du`` (l0).
+            displacement along x), each of shape (T,), at the scene's recorded
+            times up to ``steps``; ``overlapping`` (int64 scalar: starts while
+            another node was moving); ``moving_at_end`` (int64 scalar: nodes
+            still moving at t = steps); ``stop_speed`` (float, l0 per tau_dyn:
+            the largest speed set to zero at a stop, in 2D ~STOP_SPEED Ntilde;
+            in 1D the root finder's residual); ``slips``, a dict of arrays of
+            shape (S,), one per slip that came to rest by t = ``steps``, in
+            the order they ended: ``start`` and ``end`` (tau_th), ``duration``
+            (tau_th, computed in the integrator's local time, so exact even
+            where ``start`` is large), ``node`` (int64), ``du`` (l0; shape
+            (S, 2) in 2D, the vector displacement).
 
-            With ``states``, also, each of shape (T, N) except ``theta``:
-            ``u``, the displacements from the reference positions (l0; u = 0
-            is every spring at rest at theta(0)); ``mu_s``, the thresholds;
-            ``F``, the forces on the nodes (N: springs, dilation and f_ext);
-            ``theta``, shape (T,), theta(t) - theta(0) (dimensionless). A node
-            still moving at a recorded time (rare: the records fall between
-            two thermal segments) is recorded where it is.
+            With ``states``, also, each of shape (T, N) in 1D and (T, N, 2)
+            in 2D (``mu_s``: (T, N); ``theta``: (T,)): ``u``, the
+            displacements from the reference positions (l0; u = 0 is every
+            spring at rest at theta(0)); ``mu_s``, the thresholds; ``F``, the
+            forces on the nodes (N: springs, dilation and f_ext); ``theta``,
+            theta(t) - theta(0) (dimensionless). A node still moving at a
+            recorded time (rare: the records fall between two thermal
+            segments) is recorded where it is.
         """
         scene = self.scene
         steps = scene.steps if steps is None else steps
@@ -250,13 +285,14 @@ class Dynamics:
                   rate: float = TILT_RATE) -> dict[str, float]:
         """The dynamic tilt test: raise a uniform tilt on a state under the equations of motion until it slides.
 
-        The tangential force f N_i along +x (a tilt by tan(alpha) = f) is
-        added to every node and f rises from 0 at ``rate`` per tau_dyn,
-        theta frozen; the nodes move by eq. `dynamics`, as in :meth:`run`: a
-        node starts when |F_i| reaches mu_s,i N_i, and one whose velocity
-        returns to zero gets a new threshold (from ``rng``) and sticks, or
-        starts again if it is above it. While nothing moves, u is fixed and
-        the next start is found in closed form (no steps).
+        The tangential force f N_i along +x (a tilt by tan(alpha) = f; in 2D
+        the direction of the quasi-static network tilt test) is added to every
+        node and f rises from 0 at ``rate`` per tau_dyn, theta frozen; the
+        nodes move by eq. `dynamics`, as in :meth:`run`: a node starts, along
+        F_i, when |F_i| reaches mu_s,i N_i, and one whose velocity returns to
+        zero gets a new threshold (from ``rng``) and sticks, or starts again
+        if it is above it. While nothing moves, u is fixed and the next start
+        is found in closed form (no steps).
 
         **Slides for good.** The network slides for good from the moment
         every node moves along +x, the mean load sum_i F_i / sum_i N_i
@@ -276,6 +312,25 @@ class Dynamics:
         null vector (1, ..., 1)). The proof is checked after every event
         and every ``2 pi`` tau_dyn of motion.
 
+        **In 2D** the friction -mu_d N_i v_i/|v_i| is not uniform unless
+        every velocity has one direction, so the modes are coupled and their
+        amplitudes are not conserved; the proof uses the internal energy
+        instead. With V the centre-of-mass velocity, w_i = v_i - V and r the
+        forces less their uniform part (r_i = F_i - N_i sum_j F_j / sum_j N_j:
+        the springs' force about their equilibrium under the constant loads),
+        E = (1/2) r . K^+ r + (1/2) sum_i N_i |w_i|^2. While every node
+        slides, the tilt does no work on the w_i (sum_i N_i w_i = 0) and
+        friction only removes energy from them (sum_i N_i w_i . v_i/|v_i| =
+        sum_i N_i |v_i| - V . sum_i N_i v_i/|v_i| >= 0), so E never grows,
+        and |w_i| <= B_i = sqrt(2 E (1/N_i - 1/sum_j N_j)) (the largest |w_i|
+        at kinetic energy E with sum_j N_j w_j = 0). The load along x drives
+        V_x at sum_i F_i,x / sum_i N_i - mu_d or more, which is > 0 and only
+        grows with f. So once every node moves, that load exceeds mu_d and
+        V_x > B_i for every i, |v_i| >= V_x - B_i > 0 for ever: the network
+        never sticks again. It requires K^+ r to be the equilibrium, i.e. loads
+        f_ext + theta g whose non-uniform part has no net torque (the dilation
+        has none; a tilt or an incline is uniform per N_i).
+
         **mu_eff** is the load at the last moment the network was at rest
         (every node stuck) before it slid for good: the largest load the
         state held, where the quasi-static test's f is the load at which its
@@ -288,7 +343,7 @@ class Dynamics:
 
         Parameters
         ----------
-        u : ndarray, shape (N,)
+        u : ndarray, shape (N,) in 1D, (N, 2) in 2D
             Displacements from the reference positions, in l0 (u = 0 is
             every spring at rest at theta(0); ``Dynamics.run(states=True)``
             returns them).
@@ -318,7 +373,8 @@ class Dynamics:
         Raises
         ------
         ConfigError
-            A bad argument, or a network that is not connected or has springs to the ground.
+            A bad argument, or a network that has springs to the ground or (1D) is not connected,
+            or (2D) loads with a net torque.
         TiltTestError
             More than 1e5 starts of motion, or one motion of 1e5 tau_dyn, without sliding for good.
 
@@ -346,8 +402,9 @@ class Dynamics:
         Ntilde = self.scene.network.Ntilde
         u = np.asarray(u, dtype=np.float64)
         mu_s = np.asarray(mu_s, dtype=np.float64)
-        if u.shape != (N,) or not np.isfinite(u).all():
-            raise param_error("u", owner, f"a finite array of shape ({N},), in l0", u)
+        shape = (N,) if self.dim == 1 else (N, self.dim)
+        if u.shape != shape or not np.isfinite(u).all():
+            raise param_error("u", owner, f"a finite array of shape {shape}, in l0", u)
         if mu_s.shape != (N,) or not (np.isfinite(mu_s).all() and (mu_s > mu_d).all()):
             raise param_error("mu_s", owner, f"a finite array of shape ({N},) with every value > mu_d = {mu_d}",
                               mu_s)
@@ -365,8 +422,48 @@ class Dynamics:
 
         # theta(0) = 0 and theta = theta / Ntilde: forces() sees the state's theta - theta(0).
         real = _Realization(self, np.zeros(1), ThresholdStream(mu_s.copy(), batches()))
-        real.u = u / Ntilde
-        return real.tilt(float(theta) / Ntilde, float(rate), self.modes())
+        real.u = u.reshape(-1) / Ntilde
+        if self.dim == 1:
+            self.modes()
+        else:
+            # The proof's elastic energy needs the loads' non-uniform part in the range of K:
+            # no net torque (a spring's pair of forces has none, nor does a load uniform per N_i).
+            F = real.forces(float(theta) / Ntilde).reshape(N, 2)
+            r = (F - np.outer(self.normal_load, F.sum(axis=0) / self.normal_load.sum())).reshape(-1)
+            if np.abs(self.K @ (self.compliance() @ r) - r).max() > 1e-9 * max(np.abs(r).max(), 1.0):
+                raise ConfigError(
+                    "The dynamic tilt test of a 2D network needs loads f_ext + theta g whose part not uniform "
+                    "per unit normal load has no net torque: its proof of sliding rests on the elastic energy."
+                )
+        return real.tilt(float(theta) / Ntilde, float(rate))
+
+    def compliance(self) -> np.ndarray:
+        """K^+, the pseudo-inverse of K, for the 2D tilt test's proof of sliding.
+
+        Returns
+        -------
+        ndarray, shape (N d, N d)
+            In 1 / k0. (1/2) r . K^+ r is the elastic energy of a force r on
+            the nodes that K can balance (r in the range of K).
+
+        Raises
+        ------
+        ConfigError
+            Springs to the ground (a translation that is not a null vector of K).
+        """
+        if self._compliance is None:
+            K, d = self.K, self.dim
+            scale = np.abs(K).max() if K.size else 1.0
+            shift = np.zeros((K.shape[0], d))
+            for c in range(d):
+                shift[c::d, c] = 1.0
+            if np.abs(K @ shift).max() > 1e-12 * scale:
+                raise ConfigError(
+                    "The dynamic tilt test needs a network without springs to the ground "
+                    "(K with the translations as null vectors): its proof of sliding rests on the rigid mode."
+                )
+            self._compliance = np.linalg.pinv(K, rcond=1e-10, hermitian=True)
+        return self._compliance
 
     def modes(self) -> tuple[np.ndarray, np.ndarray]:
         """The non-rigid modes of the network, for the tilt test's proof of sliding.
@@ -393,14 +490,41 @@ class Dynamics:
         return self._modes
 
 
+def node_norms(x: np.ndarray, dim: int) -> np.ndarray:
+    """|x_i| of node-major vectors x (shape (n dim,)), shape (n,): the absolute value in 1D."""
+    return np.abs(x) if dim == 1 else np.hypot(x[0::2], x[1::2])
+
+
+def node_dots(x: np.ndarray, y: np.ndarray, dim: int) -> np.ndarray:
+    """x_i . y_i of node-major vectors (shape (n dim,)), shape (n,)."""
+    return x * y if dim == 1 else x[0::2] * y[0::2] + x[1::2] * y[1::2]
+
+
+def dofs(nodes: np.ndarray | int, dim: int) -> np.ndarray:
+    """The node-major indices (i dim + c) of the components of ``nodes``."""
+    return (np.atleast_1d(nodes)[:, None] * dim + np.arange(dim)).reshape(-1)
+
+
+def _speed_event(columns: np.ndarray, dim: int) -> Callable[[float, np.ndarray], float]:
+    """The terminal event min_i |v_i| - STOP_SPEED over the nodes whose velocities are ``y[columns]``, falling."""
+    def stop(s: float, y: np.ndarray) -> float:
+        return float(node_norms(y[columns], dim).min() - STOP_SPEED)
+
+    stop.terminal = True
+    stop.direction = -1.0
+    return stop
+
+
 class _Realization:
     """The state of one integrated realization and its event loop.
 
-    Attributes: ``u`` (N,) displacements in Ntilde l0; ``v`` (N,) velocities
-    in Ntilde l0 per tau_dyn; ``moving`` (N,) bool; ``sigma`` (N,) the sign of
-    the motion of each moving node; ``t`` the time in tau_th; ``clock`` the
-    time spent in motion, in tau_dyn (it also runs during the relaxation at
-    t = 0, where theta is frozen).
+    Attributes: ``u`` (N d,) displacements in Ntilde l0, node-major; ``v``
+    (N d,) velocities in Ntilde l0 per tau_dyn; ``moving`` (N,) bool;
+    ``sigma`` (N d,) the unit direction of F_i when node i started: in 1D
+    the sign of its motion; in 2D the direction of its friction while
+    v_i = 0 (see the module's "How it is integrated"); ``t`` the time in
+    tau_th; ``clock`` the time spent in motion, in tau_dyn (it also runs
+    during the relaxation at t = 0, where theta is frozen).
     """
 
     def __init__(self, dyn: Dynamics, thetas: np.ndarray, draws: ThresholdStream) -> None:
@@ -408,32 +532,34 @@ class _Realization:
         self.thetas = thetas
         self.draws = draws
         N = dyn.normal_load.size
+        nd = N * dyn.dim
         self.mu = draws.initial.copy()
         self.lim = self.mu * dyn.normal_load
-        self.u = np.zeros(N)
-        self.v = np.zeros(N)
+        self.u = np.zeros(nd)
+        self.v = np.zeros(nd)
         self.moving = np.zeros(N, bool)
-        self.sigma = np.zeros(N)
+        self.sigma = np.zeros(nd)
         self.t = 0.0
         self.clock = 0.0
         self.n = 0
         self.overlapping = 0
+        self.stop_speed = 0.0  # the largest |v_i| set to zero at a stop, Ntilde l0 per tau_dyn
         self.start_t = np.zeros(N)
         self.start_clock = np.zeros(N)
-        self.start_u = np.zeros(N)
-        self.slips: list[tuple[float, float, float, int, float]] = []
-        self.f = 0.0  # the tilt load per unit normal load (tilt only)
+        self.start_u = np.zeros(nd)
+        self.slips: list[tuple[float, float, float, int, np.ndarray]] = []
+        self.f = 0.0  # the tilt load per unit normal load, along x (tilt only)
 
     def forces(self, theta: float) -> np.ndarray:
-        """F = -K u + (theta - theta(0)) g + f_ext + f N, in N, shape (N,); theta in units of Ntilde.
+        """F = -K u + (theta - theta(0)) g + f_ext + f N x, in N, shape (N d,); theta in units of Ntilde.
 
         u = 0 is every spring at rest at theta(0), as in the solver (a = -g theta(0)).
-        f is the tilt load of :meth:`tilt`, 0 (and left out) under the thermal drive.
+        f is the tilt load of :meth:`tilt`, along x, 0 (and left out) under the thermal drive.
         """
         d = self.d
         F = d.f_ext - d.K @ self.u + d.g * (theta - self.thetas[0])
         if self.f:
-            F += self.f * d.normal_load
+            F[0::d.dim] += self.f * d.normal_load
         return F
 
     def run(self, steps: int, states: bool = False) -> dict[str, np.ndarray]:
@@ -443,9 +569,10 @@ class _Realization:
         out_mu_max = np.zeros(rec.size)
         out_xg = np.zeros(rec.size)
         N = d.normal_load.size
-        out_u = np.zeros((rec.size, N)) if states else None
+        shape = (N,) if d.dim == 1 else (N, d.dim)
+        out_u = np.zeros((rec.size, *shape)) if states else None
         out_mu = np.zeros((rec.size, N)) if states else None
-        out_F = np.zeros((rec.size, N)) if states else None
+        out_F = np.zeros((rec.size, *shape)) if states else None
         # An f_ext above some thresholds is relaxed with theta frozen at
         # theta(0), before the t = 0 record, as the solver does.
         self._start_overloaded(thetas[0])
@@ -458,18 +585,19 @@ class _Realization:
             if k < rec.size and rec[k] == q:
                 out_n[k] = self.n
                 out_mu_max[k] = self.mu.max()
-                out_xg[k] = d.w @ self.u
+                out_xg[k] = d.w @ self.u[0::d.dim]
                 if states:
                     # Every node is at rest here except those still moving at the step (moving_at_end).
-                    out_u[k] = self.u
+                    out_u[k] = self.u.reshape(shape)
                     out_mu[k] = self.mu
-                    out_F[k] = self.forces(thetas[q])
+                    out_F[k] = self.forces(thetas[q]).reshape(shape)
                 k += 1
             if q == steps:
                 break
             self._segment(q, thetas[q], thetas[q + 1])
         Ntilde = d.scene.network.Ntilde
-        slips = np.array(self.slips, dtype=float).reshape(-1, 5)
+        starts = np.array([slip[:4] for slip in self.slips], dtype=float).reshape(-1, 4)
+        du = np.array([slip[4] for slip in self.slips], dtype=float).reshape(-1, d.dim)
         extra = {}
         if states:
             extra = {"u": out_u * Ntilde, "mu_s": out_mu, "F": out_F,
@@ -481,12 +609,13 @@ class _Realization:
             "x_G": out_xg * Ntilde,
             "overlapping": np.int64(self.overlapping),
             "moving_at_end": np.int64(self.moving.sum()),
+            "stop_speed": float(self.stop_speed * Ntilde),
             "slips": {
-                "start": slips[:, 0].copy(),
-                "end": slips[:, 1].copy(),
-                "duration": slips[:, 2].copy(),
-                "node": slips[:, 3].astype(np.int64),
-                "du": slips[:, 4] * Ntilde,
+                "start": starts[:, 0].copy(),
+                "end": starts[:, 1].copy(),
+                "duration": starts[:, 2].copy(),
+                "node": starts[:, 3].astype(np.int64),
+                "du": (du[:, 0] if d.dim == 1 else du) * Ntilde,
             },
             **extra,
         }
@@ -507,141 +636,194 @@ class _Realization:
                 self._check_runaway()
             else:
                 # Nothing moves: theta drives F through g (eq. `critique`).
-                wait, j, sign = self._next_start(self.forces(theta), self.d.g * rate)
+                wait, j = self._next_start(self.forces(theta), self.d.g * rate)
                 # Inclusive at the end of the segment, as the solver's eq. `critique`.
                 if j < 0 or self.t + wait > q + 1:
                     break
                 self.t += wait
-                self._start(j, sign)
-                self._start_overloaded(theta_a + rate * (self.t - q))
+                theta = theta_a + rate * (self.t - q)
+                self._start(j, self.forces(theta))
+                self._start_overloaded(theta)
         self.t = float(q + 1)
 
-    def _next_start(self, F: np.ndarray, drive: np.ndarray) -> tuple[float, int, float]:
+    def _next_start(self, F: np.ndarray, drive: np.ndarray) -> tuple[float, int]:
         """Nothing moves: the first start under a linear drive, in closed form.
 
         u is constant, so F_j(x) = F_j + drive_j x, with x the time (or
         load) in whatever unit ``drive`` is per; the next start is the first
-        root of |F_j(x)| = mu_s,j N_j over the driven nodes. Returns the wait
-        x >= 0, the node and the sign of its force then; the node is -1 (and
-        the wait inf) when nothing is driven.
+        root of |F_j(x)| = mu_s,j N_j over the driven nodes: linear in 1D,
+        a quadratic in 2D. Returns the wait x >= 0 and the node; the node is
+        -1 (and the wait inf) when nothing is driven.
         """
-        driven = np.flatnonzero(drive)
-        if driven.size == 0:
-            return math.inf, -1, 0.0
-        sgn = np.sign(drive[driven])
-        wait = np.maximum((self.lim[driven] - sgn * F[driven]) / np.abs(drive[driven]), 0.0)
+        dim = self.d.dim
+        lim = self.lim
+        if dim == 1:
+            driven = np.flatnonzero(drive)
+            if driven.size == 0:
+                return math.inf, -1
+            sgn = np.sign(drive[driven])
+            wait = np.maximum((lim[driven] - sgn * F[driven]) / np.abs(drive[driven]), 0.0)
+        else:
+            a = node_dots(drive, drive, dim)
+            driven = np.flatnonzero(a > 0.0)
+            if driven.size == 0:
+                return math.inf, -1
+            a = a[driven]
+            b = node_dots(F, drive, dim)[driven]
+            c = node_dots(F, F, dim)[driven] - lim[driven] ** 2
+            root = np.sqrt(np.maximum(b * b - a * c, 0.0))
+            # The positive root of a x^2 + 2 b x + c = 0 (c < 0 below the threshold), in the form
+            # without cancellation for either sign of b.
+            with np.errstate(divide="ignore", invalid="ignore"):
+                wait = np.where(b >= 0.0, -c / (b + root), (root - b) / a)
+            wait = np.where(c >= 0.0, 0.0, wait)
         j = int(np.argmin(wait))
-        return wait[j], int(driven[j]), sgn[j]
+        return float(wait[j]), int(driven[j])
 
-    def _start(self, i: int, sign: float) -> None:
-        """Node i starts moving with the sign ``sign``: one rearrangement."""
+    def _start(self, i: int, F: np.ndarray) -> None:
+        """Node i starts moving along its force F_i (``F``: every node's, shape (N d,)): one rearrangement."""
         if self.moving.any():
             self.overlapping += 1
         self.n += 1
         self.moving[i] = True
-        self.sigma[i] = sign
-        self.v[i] = 0.0
+        k = dofs(i, self.d.dim)
+        self.sigma[k] = F[k] / node_norms(F[k], self.d.dim)  # the sign of F_i in 1D
+        self.v[k] = 0.0
         self.start_t[i] = self.t
         self.start_clock[i] = self.clock
-        self.start_u[i] = self.u[i]
+        self.start_u[k] = self.u[k]
 
     def _start_overloaded(self, theta: float) -> None:
         """Start every stuck node above its threshold, the largest overload first."""
         while True:
             F = self.forces(theta)
-            over = np.where(self.moving, 0.0, np.abs(F) / self.lim)
+            over = np.where(self.moving, 0.0, node_norms(F, self.d.dim) / self.lim)
             i = int(np.argmax(over))
             if over[i] <= 1.0:
                 return
-            self._start(i, 1.0 if F[i] > 0.0 else -1.0)
+            self._start(i, F)
 
     def _move(self, theta0: float, drive: np.ndarray, s_max: float) -> tuple[float, str | None]:
         """Integrate the moving nodes from local time s = 0 to the first event or to ``s_max``.
 
         The forces at s = 0 are ``forces(theta0)``; during the phase they
-        change, besides the springs, by ``drive`` s: ``drive`` (shape (N,),
-        N per tau_dyn) is g dtheta/ds when theta drives, f' N_i when a tilt
+        change, besides the springs, by ``drive`` s: ``drive`` (shape (N d,),
+        N per tau_dyn) is g dtheta/ds when theta drives, f' N_i x when a tilt
         f(s) does (:meth:`tilt`). Updates u and v of the moving nodes and
         ``clock``; returns the time elapsed (tau_dyn) and the event,
-        ``"stop"``, ``"start"`` or None.
+        ``"stop"`` (in 1D v_i sigma_i fell to zero; in 2D |v_i| fell to
+        STOP_SPEED), ``"start"`` or None.
         """
         d = self.d
+        dim = d.dim
         M = np.flatnonzero(self.moving)
-        S = np.flatnonzero(~self.moving)
-        m = M.size
+        Md = dofs(M, dim)
+        Sd = dofs(np.flatnonzero(~self.moving), dim)
+        m = Md.size
         F0 = self.forces(theta0)
-        Nm = d.normal_load[M]
-        sig = self.sigma[M]
-        # y = (u_M - u_M(0), du_M/ds) obeys y' = A y + c s + b; with z = (y, s, 1)
-        # that is one product y' = B z, half the cost of three array operations.
+        Nm = np.repeat(d.normal_load, dim)[Md]
+        sig = self.sigma[Md]
+        mu_d = d.scene.mu_d
+        # y = (u_M - u_M(0), du_M/ds) obeys y' = A y + c s + b with friction along sigma; with
+        # z = (y, s, 1) that is one product y' = B z, half the cost of three array operations.
         B = np.zeros((2 * m, 2 * m + 2))
         B[:m, m:2 * m] = np.eye(m)
-        B[m:, :m] = -d.K[np.ix_(M, M)] / Nm[:, None]
-        B[m:, 2 * m] = drive[M] / Nm
-        B[m:, 2 * m + 1] = (F0[M] - d.scene.mu_d * Nm * sig) / Nm
+        B[m:, :m] = -d.K[np.ix_(Md, Md)] / Nm[:, None]
+        B[m:, 2 * m] = drive[Md] / Nm
+        B[m:, 2 * m + 1] = (F0[Md] - mu_d * Nm * sig) / Nm
         z = np.zeros(2 * m + 2)
         z[-1] = 1.0
 
-        def rhs(s: float, y: np.ndarray) -> np.ndarray:
-            z[:-2] = y
-            z[-2] = s
-            return B @ z
+        if dim == 1:
+            def rhs(s: float, y: np.ndarray) -> np.ndarray:
+                z[:-2] = y
+                z[-2] = s
+                return B @ z
+        else:
+            def rhs(s: float, y: np.ndarray) -> np.ndarray:
+                z[:-2] = y
+                z[-2] = s
+                out = B @ z
+                # Friction along -v_i/|v_i| (per unit mass mu_d, as m_i = N_i m), not along -sigma_i:
+                # B holds the part along sigma_i, this the difference. At v_i = 0 (a node starting) the
+                # direction is sigma_i, the force's.
+                v = y[m:]
+                speed = np.repeat(node_norms(v, dim), dim)
+                out[m:] -= mu_d * np.where(speed > 0.0, v / np.where(speed > 0.0, speed, 1.0) - sig, 0.0)
+                return out
 
-        def stop(s: float, y: np.ndarray) -> float:
-            # A node that starts at s = 0 has zero velocity there: a placeholder > 0 at s = 0 keeps
-            # the root finder from stopping it at once when another node stops within the first step.
-            if s == 0.0:
-                return 1.0
-            return float((sig * y[m:]).min())
+        if dim == 1:
+            def stop(s: float, y: np.ndarray) -> float:
+                # A node that starts at s = 0 has zero velocity there: a placeholder > 0 at s = 0 keeps
+                # the root finder from stopping it at once when another node stops within the first step.
+                if s == 0.0:
+                    return 1.0
+                return float((sig * y[m:]).min())
 
-        stop.terminal = True
-        stop.direction = -1.0
-        events = [stop]
-        if S.size:
-            K_SM = d.K[np.ix_(S, M)]
-            F0_S = F0[S]
-            g_S = drive[S]
-            lim_S = self.lim[S]
+            stop.terminal = True
+            stop.direction = -1.0
+            events = [stop]
+        else:
+            # |v_i| falls to STOP_SPEED. The nodes that start at s = 0 rise through it first, which the
+            # direction -1 ignores; watched apart, they cannot hide the fall of a node already moving.
+            starting = node_norms(self.v[Md], dim) < STOP_SPEED
+            events = []
+            for group in (starting, ~starting):
+                if group.any():
+                    events.append(_speed_event(dofs(np.flatnonzero(group), dim) + m, dim))
+        n_stop = len(events)
+        if Sd.size:
+            K_SM = d.K[np.ix_(Sd, Md)]
+            F0_S = F0[Sd]
+            g_S = drive[Sd]
+            lim_S = self.lim[~self.moving]
 
             def start(s: float, y: np.ndarray) -> float:
-                return float((np.abs(F0_S - K_SM @ y[:m] + g_S * s) - lim_S).max())
+                return float((node_norms(F0_S - K_SM @ y[:m] + g_S * s, dim) - lim_S).max())
 
             start.terminal = True
             start.direction = 1.0
             events.append(start)
-        y0 = np.concatenate([np.zeros(m), self.v[M]])
+        y0 = np.concatenate([np.zeros(m), self.v[Md]])
         sol = solve_ivp(rhs, (0.0, s_max), y0, method=d.method, rtol=d.rtol, atol=d.atol,
                         max_step=d.max_step, events=events)
-        if sol.status == -1:  # pragma: no cover - a linear right-hand side does not fail
+        if sol.status == -1:  # pragma: no cover - the right-hand side is smooth between events
             raise RuntimeError(f"solve_ivp failed at t = {self.t} tau_th: {sol.message}")
         s1 = float(sol.t[-1])
         y1 = sol.y[:, -1]
-        self.u[M] += y1[:m]
-        self.v[M] = y1[m:]
+        self.u[Md] += y1[:m]
+        self.v[Md] = y1[m:]
         self.clock += s1
         kind = None
         if sol.status == 1:
-            kind = "stop" if sol.t_events[0].size else "start"
+            kind = "stop" if any(sol.t_events[e].size for e in range(n_stop)) else "start"
         return s1, kind
 
     def _after_move(self, s1: float, kind: str | None, theta: float) -> None:
         """Apply the event that ended a phase (``self.t`` and u already at its time)."""
         d = self.d
+        dim = d.dim
         if kind == "stop":
             M = np.flatnonzero(self.moving)
-            i = int(M[np.argmin(self.sigma[M] * self.v[M])])
+            v_M = self.v[dofs(M, dim)]
+            if dim == 1:
+                i = int(M[np.argmin(self.sigma[M] * v_M)])
+            else:
+                i = int(M[np.argmin(np.abs(node_norms(v_M, dim) - STOP_SPEED))])
+            k = dofs(i, dim)
+            self.stop_speed = max(self.stop_speed, float(node_norms(self.v[k], dim)[0]))
             self.moving[i] = False
-            self.v[i] = 0.0
+            self.v[k] = 0.0
             self.slips.append((self.start_t[i], self.t, (self.clock - self.start_clock[i]) * d.tau_ratio, i,
-                               self.u[i] - self.start_u[i]))
+                               self.u[k] - self.start_u[k]))
             # A new place on the substrate: a new threshold.
             self.mu[i] = self.draws.next()
             self.lim[i] = self.mu[i] * d.normal_load[i]
         elif kind == "start":
             F = self.forces(theta)
             S = np.flatnonzero(~self.moving)
-            j = int(S[np.argmax(np.abs(F[S]) - self.lim[S])])
-            self._start(j, 1.0 if F[j] > 0.0 else -1.0)
+            j = int(S[np.argmax(node_norms(F, dim)[S] - self.lim[S])])
+            self._start(j, F)
         # A stopped node above its new threshold starts again, and a node that
         # the event left above its threshold (a tie) starts too.
         self._start_overloaded(theta)
@@ -657,14 +839,14 @@ class _Realization:
                 "for ever; lower f_ext."
             )
 
-    def tilt(self, theta: float, rate: float, modes: tuple[np.ndarray, np.ndarray]) -> dict[str, float]:
-        """The loop of :meth:`Dynamics.tilt_test`: theta frozen (units of Ntilde), f(s) = rate s."""
+    def tilt(self, theta: float, rate: float) -> dict[str, float]:
+        """The loop of :meth:`Dynamics.tilt_test`: theta frozen (units of Ntilde), f(s) = rate s along x."""
         d = self.d
         mu_d = float(d.scene.mu_d)
         N = d.normal_load
-        drive = rate * N  # dF_i/ds of the tilt, N per tau_dyn
-        f_bar = float(d.f_ext.sum() / N.sum())
-        lam, phi = modes
+        drive = np.zeros_like(self.u)
+        drive[0::d.dim] = rate * N  # dF_i/ds of the tilt, N per tau_dyn
+        f_bar = float(d.f_ext[0::d.dim].sum() / N.sum())
         first = all_moving = math.nan
         # An overloaded state starts moving at f = 0: the network was never at rest.
         self._start_overloaded(theta)
@@ -680,13 +862,13 @@ class _Realization:
                 )
             if not self.moving.any():
                 # At rest: u is fixed and F grows by drive per tau_dyn, so the next start is exact.
-                wait, j, _ = self._next_start(self.forces(theta), drive)
+                wait, j = self._next_start(self.forces(theta), drive)
                 self.f += rate * wait
                 rest = self.f + f_bar
                 if math.isnan(first):
                     first = rest
                 avalanche = 0.0
-                self._start(j, 1.0)
+                self._start(j, self.forces(theta))
                 self._start_overloaded(theta)
             else:
                 s1, kind = self._move(theta, drive, TILT_CHUNK)
@@ -695,7 +877,7 @@ class _Realization:
                 self._after_move(s1, kind, theta)
             if math.isnan(all_moving) and self.moving.all():
                 all_moving = self.f + f_bar
-            if self._slides_for_good(theta, mu_d, lam, phi):
+            if self._slides_for_good(theta, mu_d):
                 return {"mu_eff": rest, "first_start": first, "all_moving": all_moving,
                         "certified": self.f + f_bar, "starts": int(self.n)}
             if avalanche > TILT_MAX_AVALANCHE:
@@ -704,15 +886,34 @@ class _Realization:
                     f"that it slides for good (load {self.f + f_bar!r})."
                 )
 
-    def _slides_for_good(self, theta: float, mu_d: float, lam: np.ndarray, phi: np.ndarray) -> bool:
-        """Every node moves forward, the rigid mode accelerates, and no node's velocity can return to zero."""
-        if not self.moving.all() or (self.sigma < 0).any():
+    def _slides_for_good(self, theta: float, mu_d: float) -> bool:
+        """Every node moves, the mean load along x exceeds mu_d, and no node's velocity can return to zero.
+
+        1D: the bound of each node's velocity about the centre of mass's from the conserved
+        amplitudes of the modes; 2D: from the internal energy, which friction only lowers
+        (:meth:`Dynamics.tilt_test`).
+        """
+        if not self.moving.all():
             return False
-        N = self.d.normal_load
+        d = self.d
+        dim = d.dim
+        N = d.normal_load
         F = self.forces(theta)
-        if F.sum() / N.sum() <= mu_d:
+        if F[0::dim].sum() / N.sum() <= mu_d:
             return False
-        V = float(N @ self.v / N.sum())
-        amplitude = np.sqrt((phi.T @ F) ** 2 / lam + (phi.T @ (N * self.v)) ** 2)
-        bound = np.abs(phi) @ amplitude
-        return bool((V > bound).all())
+        if dim == 1:
+            if (self.sigma < 0).any():
+                return False
+            lam, phi = d.modes()
+            V = float(N @ self.v / N.sum())
+            amplitude = np.sqrt((phi.T @ F) ** 2 / lam + (phi.T @ (N * self.v)) ** 2)
+            bound = np.abs(phi) @ amplitude
+            return bool((V > bound).all())
+        v = self.v.reshape(-1, dim)
+        V = N @ v / N.sum()
+        # r = F less its uniform part N_i sum(F) / sum(N): the springs' force about their
+        # equilibrium under the constant loads, so (1/2) r . K^+ r is the elastic energy above it.
+        r = (F.reshape(-1, dim) - np.outer(N, F.reshape(-1, dim).sum(axis=0) / N.sum())).reshape(-1)
+        energy = 0.5 * r @ (d.compliance() @ r) + 0.5 * N @ ((v - V) ** 2).sum(axis=1)
+        bound = np.sqrt(2.0 * max(energy, 0.0) * (1.0 / N - 1.0 / N.sum()))
+        return bool((V[0] > bound).all())
