@@ -25,6 +25,10 @@ from tests.test_output_folders import SMALL  # a run of two sliders, 2 realizati
 CTRL_C_AT_IMPORT = textwrap.dedent("""\
     import importlib.abc, os, signal, sys
 
+    # Python's own Ctrl-C handler, as in a terminal: a process started in the background by a shell without job
+    # control (nohup, `cmd &` in a script, some CI runners) inherits SIGINT ignored, and would never see it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
     class CtrlC(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path, target=None):
             if name == sys.argv[1]:
