@@ -29,6 +29,7 @@ from slidernet.config.solver import SolverConfig
 from slidernet.config.tilt import TiltConfig
 from slidernet.config.units import _UNITS_RTOL, UnitsConfig, _fill_from_units
 from slidernet.model.builders import KIND_DIMS
+from slidernet.model.network import Network, pair_tilt_applies
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
@@ -233,11 +234,14 @@ class Config(_Strict):
         return (self.needs_catalogue() or "contact_age" in self.observables
                 or self.friction.strengthening is not None)
 
-    def pair_tilt_applies(self) -> bool:
+    def pair_tilt_applies(self, network: Network | None = None) -> bool:
         """True if the appendix's tilt test before every rearrangement can be this run's mu_eff: a 1D pair
-        (:meth:`NetworkConfig.pair_tilt_applies`) whose thresholds do not strengthen (its test reads the
+        (:func:`~slidernet.model.network.pair_tilt_applies` of ``network``, or of the configured one,
+        :meth:`NetworkConfig.pair_tilt_applies`) whose thresholds do not strengthen (its test reads the
         pair kernel's thresholds, which have no age)."""
-        return self.friction.strengthening is None and self.network.pair_tilt_applies()
+        if self.friction.strengthening is not None:
+            return False
+        return self.network.pair_tilt_applies() if network is None else pair_tilt_applies(network)
 
     def tilt_settings(self) -> TiltConfig:
         """The [tilt] table, or its defaults where it is not given."""

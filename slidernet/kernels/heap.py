@@ -285,10 +285,18 @@ def open_recomputed_avalanche(st, heaps, thetas):
     st.av_slips = -1
     st.in_avalanche = 1
     st.n_events += 1
-    time = float(q)
+    st.event_time = min(max(theta_time(thetas, q, st.theta), float(q)), math.nextafter(q + 1.0, q))
+
+
+@kernel_jit(forceinline=True)
+def theta_time(thetas, q, theta):
+    """The time (tau_th) at which theta, linear in step q, is at ``theta``: q plus the fraction of the step
+    covered; q where theta stands still in the step, or after the last step. Not clamped to the step.
+    (The solver also calls it from Python, as ``theta_time.py_func``, for the time of a realization's state.)
+    """
     if q + 1 < thetas.size and thetas[q + 1] != thetas[q]:
-        time = q + (st.theta - thetas[q]) / (thetas[q + 1] - thetas[q])
-    st.event_time = min(max(time, float(q)), math.nextafter(q + 1.0, q))
+        return q + (theta - thetas[q]) / (thetas[q + 1] - thetas[q])
+    return float(q)
 
 
 @kernel_jit(forceinline=True)

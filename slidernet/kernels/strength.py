@@ -32,15 +32,19 @@ first node whose exact event leads the tree is the event (a lazy search,
 which solves only the nodes whose bound falls within the step). The root is
 bracketed and found by the Illinois variant of regula falsi on the fixed
 point theta = theta_c(mu_s,i(t(theta))) (eq. `critique`'s root with the
-threshold at theta's time), to a bracket of at most 4 eps |theta| (4 to 8 ulp of theta); the
-slip then starts at the threshold of the bracket's end, |F_i| = mu_s,i N_i
+threshold at theta's time), to a bracket of at most 4 eps |theta| (4 to 8
+ulp of theta); the slip then starts at the threshold of the bracket's end, |F_i| = mu_s,i N_i
 to the rounding of eq. `critique`'s root, as without strengthening.
 
-Nodes a slip touches are brought up to date at the avalanche's time
-(:func:`refresh`, in each geometry's ``update_node_aging``), so that every
+The nodes a slip moves are brought up to the avalanche's time first
+(:func:`refresh_row`, in each geometry's ``move_node_aging``), so that every
 stability test of an avalanche reads the threshold of that moment; at an
 output step every node is (:func:`refresh_all`), so that mu_max, mu_mean,
 mu_min and the network tilt test read the thresholds of the record's time.
+All of it reads ``nodes.mu0`` and ``nodes.law``, which only an
+:data:`~slidernet.kernels.state.AgingNodes` has: the kernels of scenes
+without strengthening are compiled for :class:`~slidernet.kernels.state.Nodes`
+and carry none of it.
 """
 
 from __future__ import annotations
@@ -132,10 +136,8 @@ def _refresh_at_record(st, nodes, t):
 @kernel_jit(inline="always")
 def solve_event(st, net, nodes, j, thetas, s, critical_roots):
     """Set node j's threshold to its value at its exact event in step q, or at the end of the step if it
-    has none there; True if it has one.
-
-    On return ``nodes.mu[j]`` makes eq. `critique`'s root the event (or a point past the step).
-    """
+    has none there: on return ``nodes.mu[j]`` makes eq. `critique`'s root the event (or a point past the
+    step)."""
     q = nonneg(st.q)
     theta_a = thetas[q]
     theta_b = thetas[q + 1]
@@ -145,10 +147,10 @@ def solve_event(st, net, nodes, j, thetas, s, critical_roots):
     hi = theta_b
     f_hi = _crossing_at(net, nodes, j, hi, theta_a, rate, t0, s, critical_roots)
     if f_hi > 0.0:
-        return False  # its threshold at the step's end is not reached within the step: no event in it
+        return  # its threshold at the step's end is not reached within the step: no event in it
     f_lo = _crossing_at(net, nodes, j, lo, theta_a, rate, t0, s, critical_roots)
     if f_lo <= 0.0:
-        return True  # at its threshold already (rounding): the event is now
+        return  # at its threshold already (rounding): the event is now
     side = 0
     for it in range(ROOT_ITER + 64):
         if abs(hi - lo) <= 4.0 * EPS * max(abs(hi), abs(lo)):
@@ -171,7 +173,6 @@ def solve_event(st, net, nodes, j, thetas, s, critical_roots):
                 f_lo *= 0.5
             side = 1
     _crossing_at(net, nodes, j, hi, theta_a, rate, t0, s, critical_roots)
-    return True
 
 
 @kernel_jit(inline="always")

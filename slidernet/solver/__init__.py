@@ -15,12 +15,12 @@
   event catalogue.
 """
 
+from slidernet.model.network import pair_tilt_applies
 from slidernet.solver.realization import Realization, simulate
 from slidernet.solver.scene import (
     EVENT_CHUNK,
     Scene,
     build_network,
-    pair_tilt_applies,
     record_times,
     tilt_avalanche_cap,
 )

@@ -41,6 +41,7 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.errors import SnapshotError
+from slidernet.kernels.heap import theta_time
 from slidernet.solver.scene import EVENT_CHUNK, SLIP_EXACT, Scene
 from slidernet.solver.snapshot import take
 
@@ -356,11 +357,8 @@ def state_time(real: Host) -> float:
     """The time of the realization's state, in tau_th: q plus the fraction of step q that theta has covered
     (q where theta stands still in the step, or at its start)."""
     st = real.state[0]
-    q = int(st["q"])
-    thetas = real.thetas
-    if q + 1 >= thetas.size or thetas[q + 1] == thetas[q]:
-        return float(q)
-    return q + float((st["theta"] - thetas[q]) / (thetas[q + 1] - thetas[q]))
+    # The kernels' own formula, run as Python: nothing to compile for it.
+    return float(theta_time.py_func(real.thetas, int(st["q"]), st["theta"]))
 
 
 # The one place where a kernel's name is read: the scene's choice picks the backend.

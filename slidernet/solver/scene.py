@@ -13,7 +13,7 @@ from slidernet.config import Config, build_network, choose_kernel, choose_tilt_a
 from slidernet.errors import ConfigError
 from slidernet.kernels import Chain, Plane, Settings, tilt_net
 from slidernet.kernels.assembly import diagonal_positions
-from slidernet.model.network import Network, pair_tilt_applies
+from slidernet.model.network import Network
 from slidernet.solver.creep import CreepSpec, reference_slip
 
 
@@ -209,8 +209,7 @@ class Scene:
         tilt_at = None
         if "mu_eff" in cfg.observables:
             try:
-                tilt_at = choose_tilt_at(cfg.mu_eff_at,
-                                         pair_tilt_applies(net) and cfg.friction.strengthening is None)
+                tilt_at = choose_tilt_at(cfg.mu_eff_at, cfg.pair_tilt_applies(net))
             except ValueError as exc:  # a network given here that the configuration's checks never saw
                 raise ConfigError(f"The 'mu_eff_at' field: {exc}.") from None
         slide_away = mean_load(net) > cfg.friction.mu_d
