@@ -43,9 +43,20 @@ in 2D::
 They cost far more: ~280 slips per tau_th at 16 sliders and ~14 ms of CPU each, so 16 realizations
 to 30 tau_th take ~30 CPU-minutes at 16 sliders and several CPU-hours at 64. The JSON is written
 after every realization with those done so far (``realizations_done``), so a run cut short keeps
-them; ``--from-json`` prints its tables. ``--rate-check R`` instead
-tests the states of the first R realizations at ten times and a tenth of the ramp rate, the
-effect of the rate on the dynamic tilt test (``--rate-check 4 --sizes 3 4``: about 2 min).
+them; ``--from-json`` prints its tables. ``--first``/``--stop`` run a range of the R realizations (same
+seeds and streams as in the whole run) and ``--merge`` joins such runs into one, so the two cores of a
+laptop can share a long run::
+
+    PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --geometry irregular --sizes 64 --realizations 16 \
+        --steps 30 --first 0 --stop 8 --out part_a.json &
+    PYTHONPATH=$PWD python benchmarks/aging_dynamics.py --geometry irregular --sizes 64 --realizations 16 \
+        --steps 30 --first 8 --stop 16 --out part_b.json
+    python benchmarks/aging_dynamics.py --merge part_a.json part_b.json --out aging_dynamics_2d_64.json
+
+The merged statistics are those of the whole run (tested on chains of 3: every value the same).
+
+``--rate-check R`` instead tests the states of the first R realizations at ten times and a tenth of
+the ramp rate, the effect of the rate on the dynamic tilt test (``--rate-check 4 --sizes 3 4``: about 2 min).
 """
 
 from __future__ import annotations
@@ -56,6 +67,7 @@ import math
 import platform
 import sys
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -153,76 +165,119 @@ def summary(values: np.ndarray, t: np.ndarray, T: int) -> dict[str, Any]:
 
 
 def measure(n: int, args: argparse.Namespace, done: list[dict[str, Any]] | None = None) -> dict[str, Any]:
-    """The three-way comparison at size n. After each realization the JSON is written with the
-    realizations done so far (the sizes in ``done`` first), so a run cut short keeps them."""
+    """The three-way comparison at size n, on realizations ``args.first`` to ``args.stop`` of R (all by
+    default). After each realization the JSON is written with the realizations done so far (the sizes in
+    ``done`` first), so a run cut short keeps them."""
     R, T, seed = args.realizations, args.steps, args.seed
+    rows = list(range(args.first, min(args.stop or R, R)))
     cfg = config(n, T, R, seed, args.geometry, args.network_seed)
     clock = time.perf_counter()
     ds = slidernet.run(cfg)
     qs_seconds = time.perf_counter() - clock
     t = ds["t"].values.astype(np.int64)
-    qs = ds["mu_eff_realization"].transpose("realization", "t").values
+
+    def by_realization(name: str) -> np.ndarray:
+        return ds[name].transpose("realization", ...).values[rows]
+
+    arrays = {"qs": by_realization("mu_eff_realization"), "qs_first_slip": by_realization("tilt_first_slip"),
+              "qs_all_moving": by_realization("tilt_all_moving")}
+    qs_slips = by_realization("n")[:, -1]
 
     scene = Scene.from_config(load_config(cfg))
     dyn = Dynamics(scene, tau_ratio=args.tau_ratio, max_step=args.max_step)
     seeds = realization_seeds(seed, R)
     keys = ("qs_tilt", "dyn_tilt", "dyn_first_start", "dyn_all_moving", "dyn_certified", "dyn_starts")
-    vals = {key: np.full((R, t.size), np.nan) for key in keys}
-    slips = np.zeros(R, np.int64)
+    vals = {key: np.full((len(rows), t.size), np.nan) for key in keys}
+    slips = np.zeros(len(rows), np.int64)
     clock = time.perf_counter()
     dyn_seconds = tilt_seconds = 0.0
-    for r in range(R):
+    for i, r in enumerate(rows):
         c0 = time.perf_counter()
         out = dyn.run(seeds[r], states=True)
         c1 = time.perf_counter()
         dyn_seconds += c1 - c0
         assert np.array_equal(out["t"], t)
-        slips[r] = out["n"][-1]
+        slips[i] = out["n"][-1]
         for k in range(t.size):
             # A node still moving at a record (rare: records fall between thermal segments) is tested
             # where it is, at rest.
-            vals["qs_tilt"][r, k] = qs_tilt(scene, out["F"][k], out["mu_s"][k], seed, (r, k))
+            vals["qs_tilt"][i, k] = qs_tilt(scene, out["F"][k], out["mu_s"][k], seed, (r, k))
             rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r, KEY_DYN, k)))
             res = dyn.tilt_test(out["u"][k], out["mu_s"][k], rng, theta=float(out["theta"][k]), rate=args.rate)
-            vals["dyn_tilt"][r, k] = res["mu_eff"]
-            vals["dyn_first_start"][r, k] = res["first_start"]
-            vals["dyn_all_moving"][r, k] = res["all_moving"]
-            vals["dyn_certified"][r, k] = res["certified"]
-            vals["dyn_starts"][r, k] = res["starts"]
+            vals["dyn_tilt"][i, k] = res["mu_eff"]
+            vals["dyn_first_start"][i, k] = res["first_start"]
+            vals["dyn_all_moving"][i, k] = res["all_moving"]
+            vals["dyn_certified"][i, k] = res["certified"]
+            vals["dyn_starts"][i, k] = res["starts"]
         tilt_seconds += time.perf_counter() - c1
         if args.progress:
             elapsed = time.perf_counter() - clock
-            print(f"  n={n} r={r} slips={slips[r]} {elapsed:.1f} s", file=sys.stderr, flush=True)
-        if r >= 1 and r < R - 1:
-            part = reduce(n, args, ds, t, qs, {key: v[:r + 1] for key, v in vals.items()}, slips[:r + 1],
+            print(f"  n={n} r={r} slips={slips[i]} {elapsed:.1f} s", file=sys.stderr, flush=True)
+        with warnings.catch_warnings():
+            # One realization has no standard error yet (NaN, said by numpy); the JSON keeps its values.
+            warnings.simplefilter("ignore", RuntimeWarning)
+            part = reduce(n, args, t, {**{key: v[:i + 1] for key, v in arrays.items()},
+                                       **{key: v[:i + 1] for key, v in vals.items()}},
+                          slips[:i + 1], qs_slips[:i + 1], rows[:i + 1],
                           {"qs_run": qs_seconds, "dynamics": dyn_seconds, "tilt_tests": tilt_seconds})
+        if i < len(rows) - 1:
             write(args, [*(done or []), part], time.perf_counter() - args.start)
-    return reduce(n, args, ds, t, qs, vals, slips,
-                  {"qs_run": qs_seconds, "dynamics": dyn_seconds, "tilt_tests": tilt_seconds})
+    return part
 
 
-def reduce(n: int, args: argparse.Namespace, ds: xr.Dataset, t: np.ndarray, qs: np.ndarray,
-           vals: dict[str, np.ndarray], slips: np.ndarray, seconds: dict[str, float]) -> dict[str, Any]:
-    """The statistics of the realizations in ``vals`` (the first R' of the run, paired with the same of (i))."""
+def reduce(n: int, args: argparse.Namespace, t: np.ndarray, values: dict[str, np.ndarray], slips: np.ndarray,
+           qs_slips: np.ndarray, realizations: list[int], seconds: dict[str, float]) -> dict[str, Any]:
+    """The statistics of the given realizations: ``values`` maps each estimator to its values, shape
+    (len(realizations), len(t)), realization by realization ((i) paired with the dynamics' same realization);
+    ``slips`` and ``qs_slips`` are each realization's slips to T under the dynamics and in (i)."""
     T = args.steps
-    R = slips.size
-    result = {
-        "n": n, "geometry": args.geometry, "t": t.tolist(), "realizations_done": R,
-        "seconds": seconds,
+    result: dict[str, Any] = {
+        "n": n, "geometry": args.geometry, "t": t.tolist(), "realizations_done": len(realizations),
+        "realizations": list(realizations), "seconds": seconds,
+        "dynamics_slips": slips.tolist(), "qs_slips": qs_slips.tolist(),
         "dynamics_slips_per_tau_th": float(slips.mean() / T),
-        "qs_slips_per_tau_th": float(ds["n"].transpose("realization", "t").values[:R, -1].mean() / T),
-        "qs": summary(qs[:R], t, T),
-        "qs_first_slip": summary(ds["tilt_first_slip"].transpose("realization", "t").values[:R], t, T),
-        "qs_all_moving": summary(ds["tilt_all_moving"].transpose("realization", "t").values[:R], t, T),
+        "qs_slips_per_tau_th": float(qs_slips.mean() / T),
     }
-    for key in vals:
-        result[key] = summary(vals[key], t, T)
+    for key, v in values.items():
+        result[key] = summary(v, t, T)
     # The certified load exceeds mu_eff by the ramp during the final motion; the largest excess over all tests.
-    result["max_certified_minus_mu_eff"] = float(np.nanmax(vals["dyn_certified"] - vals["dyn_tilt"]))
-    result["dyn_tilt_below_mu_d"] = int(np.sum(vals["dyn_tilt"] <= MU_D))
-    result["dyn_all_moving_below_mu_d"] = int(np.sum(vals["dyn_all_moving"] < MU_D))
+    result["max_certified_minus_mu_eff"] = float(np.nanmax(values["dyn_certified"] - values["dyn_tilt"]))
+    result["dyn_tilt_below_mu_d"] = int(np.sum(values["dyn_tilt"] <= MU_D))
+    result["dyn_all_moving_below_mu_d"] = int(np.sum(values["dyn_all_moving"] < MU_D))
     result["compare"] = compare(result)
     return result
+
+
+def merge(paths: list[str], args: argparse.Namespace) -> dict[str, Any]:
+    """One document from runs of the same study on disjoint realizations (``--first``/``--stop``): per size,
+    the realizations in their order, the statistics recomputed over all of them, the seconds summed."""
+    docs = []
+    for path in paths:
+        with open(path) as fh:
+            docs.append(json.load(fh))
+    same = ("realizations", "steps", "seed", "geometry", "network_seed", "tau_ratio", "max_step", "rate")
+    for doc in docs[1:]:
+        for key in same:
+            if doc["parameters"][key] != docs[0]["parameters"][key]:
+                raise SystemExit(f"cannot merge: the '{key}' parameter differs ({doc['parameters'][key]!r} "
+                                 f"against {docs[0]['parameters'][key]!r})")
+    for key in same:
+        setattr(args, key, docs[0]["parameters"][key])
+    results = []
+    for n in dict.fromkeys(res["n"] for doc in docs for res in doc["results"]):
+        parts = sorted((res for doc in docs for res in doc["results"] if res["n"] == n),
+                       key=lambda res: res["realizations"][0])
+        rows = [r for res in parts for r in res["realizations"]]
+        if len(set(rows)) != len(rows):
+            raise SystemExit(f"cannot merge: size {n} has realizations run twice")
+        keys = [key for key in parts[0] if isinstance(parts[0][key], dict) and "values" in parts[0][key]]
+        values = {key: np.concatenate([np.array(res[key]["values"]) for res in parts]) for key in keys}
+        seconds = {key: sum(res["seconds"][key] for res in parts) for key in parts[0]["seconds"]}
+        results.append(reduce(n, args, np.array(parts[0]["t"]), values,
+                              np.concatenate([res["dynamics_slips"] for res in parts]),
+                              np.concatenate([res["qs_slips"] for res in parts]), rows, seconds))
+    return {**docs[0], "command": " ".join(sys.argv), "merged_from": paths,
+            "wall_seconds": max(doc["wall_seconds"] for doc in docs), "results": results}
 
 
 def rate_check(n: int, args: argparse.Namespace) -> dict[str, Any]:
@@ -327,6 +382,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", default="aging_dynamics.json")
     parser.add_argument("--progress", action="store_true")
     parser.add_argument("--from-json", metavar="PATH", help="print the tables of a saved run again; no run")
+    parser.add_argument("--first", type=int, default=0, help="run realizations first to stop - 1 of R only")
+    parser.add_argument("--stop", type=int, default=0, help="(0: R) see --first")
+    parser.add_argument("--merge", metavar="PATH", nargs="+",
+                        help="merge runs on disjoint realizations into --out and print the tables; no run")
     parser.add_argument("--rate-check", type=int, default=0, metavar="R",
                         help="instead of the study: test the states of R realizations at rate x 10 and / 10")
     args = parser.parse_args(argv)
@@ -344,6 +403,12 @@ def main(argv: list[str] | None = None) -> None:
                 print(f"| {c['n']} | {load} | {up[0]:+.1e} ± {up[1]:.1e} (max {up[2]:.1e}) "
                       f"| {down[0]:+.1e} ± {down[1]:.1e} (max {down[2]:.1e}) | {c['tests']} |")
         print(f"wall {time.perf_counter() - start:.1f} s")
+        return
+    if args.merge:
+        doc = merge(args.merge, args)
+        with open(args.out, "w") as fh:
+            json.dump(doc, fh, indent=1)
+        report(doc)
         return
     if args.from_json:
         with open(args.from_json) as fh:
