@@ -18,7 +18,7 @@ from slidernet.kernels.heap import heap_set, set_critical
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.network import init_heaps, no_tilt, run_network, tree_event
 from slidernet.kernels.state import UNSTABLE, nonneg
-from slidernet.kernels.strength import refresh_all_nodes, refresh_row, strengthened_event
+from slidernet.kernels.strength import refresh_all_nodes, strengthened_event
 from slidernet.kernels.tilt import tilt_sample
 
 
@@ -85,13 +85,6 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta):
         update_node(net, nodes, heaps, j, theta)
 
 
-@kernel_jit(forceinline=True)
-def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
-    """:func:`move_node` with contact strengthening: node i's renewed contact and the thresholds of its row
-    brought up to the avalanche's time first (:func:`~slidernet.kernels.strength.refresh_row`)."""
-    refresh_row(net, nodes, i, st.event_time)
-    move_node(net, st, nodes, heaps, i, dux, duy, theta)
-
 
 @kernel_jit(forceinline=True)
 def pair_tilt(net, st, nodes, draws, out, settings):
@@ -115,7 +108,7 @@ def run_chain(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out
 def run_chain_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`run_chain` with contact strengthening (``nodes`` an AgingNodes; see :mod:`.strength`)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement, move_node, no_tilt,
                        strengthened_event)
 
 

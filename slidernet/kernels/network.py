@@ -23,8 +23,9 @@ of K) or :mod:`slidernet.kernels.plane` (2D: vector forces, 2 x 2 blocks):
   with contact strengthening, the lazy exact search of
   :func:`slidernet.kernels.strength.strengthened_event`; the variants with
   strengthening (``run_chain_aging``, ``run_plane_aging``, ...) pass it and
-  a ``move_node`` that first brings the thresholds of the slipped node's
-  row up to date, and run on a :class:`~slidernet.kernels.state.AgingNodes`,
+  run on a :class:`~slidernet.kernels.state.AgingNodes`, for which
+  :func:`slip_node` brings the thresholds of the slipped node's row up to
+  date before it moves them (``strength.renew_contact``, compiled per type),
   so that no other kernel carries a line of it.
 
 Only the functions that take other functions are inlined into the kernel
@@ -61,7 +62,7 @@ from slidernet.kernels.heap import (
 )
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import AVALANCHE_LIMIT, DONE, DOWN, RECOMPUTE, SLID_AWAY, UNSTABLE, UP, nonneg
-from slidernet.kernels.strength import refresh_at_record
+from slidernet.kernels.strength import refresh_at_record, renew_contact
 
 
 @kernel_jit(inline="always")
@@ -91,6 +92,7 @@ def slip_node(net, st, nodes, heaps, draws, catalogue, settings, i, driving, s, 
     # nodes (each node's key reads only its own force and threshold: the same keys, in the same order,
     # as moving every force first).
     redraw_threshold(st, i, nodes.mu, draws.mu, nodes.node_slips)
+    renew_contact(st, net, nodes, i)  # strengthening only (an AgingNodes); nothing otherwise
     move_node(net, st, nodes, heaps, i, dux, duy, theta)
     return True
 

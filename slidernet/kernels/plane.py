@@ -31,7 +31,7 @@ from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.memory import prefetch
 from slidernet.kernels.network import init_heaps, no_tilt, run_network, tree_event
 from slidernet.kernels.state import UNSTABLE, nonneg
-from slidernet.kernels.strength import refresh_all_nodes, refresh_row, strengthened_event
+from slidernet.kernels.strength import refresh_all_nodes, strengthened_event
 
 _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
@@ -361,13 +361,6 @@ def move_node(net, st, nodes, heaps, i, dux, duy, theta):
         update_node(net, nodes, heaps, j, theta)
 
 
-@kernel_jit(forceinline=True)
-def move_node_aging(net, st, nodes, heaps, i, dux, duy, theta):
-    """:func:`move_node` with contact strengthening: node i's renewed contact and the thresholds of its row
-    brought up to the avalanche's time first (:func:`~slidernet.kernels.strength.refresh_row`)."""
-    refresh_row(net, nodes, i, st.event_time)
-    move_node(net, st, nodes, heaps, i, dux, duy, theta)
-
 
 @kernel_jit()
 def stiffness_times(net, u, out):
@@ -403,7 +396,7 @@ def run_plane_exact(thetas, out_steps, net, state, nodes, heaps, draws, catalogu
 def run_plane_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`run_plane` with contact strengthening (``nodes`` an AgingNodes; see :mod:`.strength`)."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement, move_node, no_tilt,
                        strengthened_event)
 
 
@@ -411,7 +404,7 @@ def run_plane_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogu
 def run_plane_exact_aging(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings):
     """:func:`run_plane_exact` with contact strengthening."""
     return run_network(thetas, out_steps, net, state, nodes, heaps, draws, catalogue, out, settings,
-                       update_node, critical_roots, slip_displacement_exact, move_node_aging, no_tilt,
+                       update_node, critical_roots, slip_displacement_exact, move_node, no_tilt,
                        strengthened_event)
 
 

@@ -37,7 +37,8 @@ ulp of theta); the slip then starts at the threshold of the bracket's end, |F_i|
 to the rounding of eq. `critique`'s root, as without strengthening.
 
 The nodes a slip moves are brought up to the avalanche's time first
-(:func:`refresh_row`, in each geometry's ``move_node_aging``), so that every
+(:func:`refresh_row`, by :func:`renew_contact` in the slip of
+:func:`slidernet.kernels.network.slip_node`), so that every
 stability test of an avalanche reads the threshold of that moment; at an
 output step every node is (:func:`refresh_all`), so that mu_max, mu_mean,
 mu_min and the network tilt test read the thresholds of the record's time.
@@ -116,6 +117,11 @@ def refresh_all(st, nodes, t):
     st.argmax = best
 
 
+def _aging(nodes) -> bool:
+    """True if numba's type of ``nodes`` is an AgingNodes: the overloads below compile their work only then."""
+    return "mu0" in getattr(nodes, "fields", ())
+
+
 def refresh_at_record(st, nodes, t):
     """At an output step: :func:`refresh_all` where ``nodes`` is an AgingNodes, nothing for Nodes (compiled
     per type by numba, :func:`_refresh_at_record`: a kernel without strengthening carries no line of it)."""
@@ -123,12 +129,30 @@ def refresh_at_record(st, nodes, t):
 
 @overload(refresh_at_record, jit_options={"cache": True})
 def _refresh_at_record(st, nodes, t):
-    if "mu0" in getattr(nodes, "fields", ()):
+    if _aging(nodes):
         def impl(st, nodes, t):
             refresh_all(st, nodes, t)
         return impl
 
     def nothing(st, nodes, t):
+        pass
+    return nothing
+
+
+def renew_contact(st, net, nodes, i):
+    """Before node i's slip moves the forces of its row: :func:`refresh_row` at the avalanche's time
+    (``st.event_time``) where ``nodes`` is an AgingNodes, nothing for Nodes (compiled per type, as
+    :func:`refresh_at_record`)."""
+
+
+@overload(renew_contact, jit_options={"cache": True})
+def _renew_contact(st, net, nodes, i):
+    if _aging(nodes):
+        def impl(st, net, nodes, i):
+            refresh_row(net, nodes, i, st.event_time)
+        return impl
+
+    def nothing(st, net, nodes, i):
         pass
     return nothing
 
