@@ -32,6 +32,7 @@ Exit status 0 when every trial passes, 1 otherwise.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import random
 import signal
@@ -175,17 +176,238 @@ def trial(k: int, mode: str, rng: random.Random, config: Path, folder: Path, ref
     return True, "; ".join(notes) + f"; {len(seen)} processes, all ended"
 
 
+# -- the faults of a cluster, a shared folder and a plugin that never returns ------------------------------------
+def wait_for(predicate, what: str, timeout: float = 300.0) -> None:
+    """Poll ``predicate`` every 20 ms until it holds (a hang guard of ``timeout`` s, never a synchronisation)."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"gave up waiting for {what} after {timeout:g} s")
+        time.sleep(0.02)
+
+
+def one_line_error(err: str) -> str | None:
+    """None if ``err`` is slidernet's one-line kind of failure (no traceback); else what is wrong with it."""
+    if "Traceback" in err:
+        return "a traceback: " + err.strip()[-600:]
+    if not any(line.startswith("slidernet:") for line in err.splitlines()):
+        return "no 'slidernet:' line: " + err.strip()[-600:]
+    return None
+
+
+def saved(out: Path) -> bool:
+    """Whether the run in ``out`` has saved some work (a finished block or a realization in progress)."""
+    folder = out / "checkpoint"
+    return folder.is_dir() and any(p.name.startswith(("block-", "partial-")) for p in folder.iterdir())
+
+
+class DaskCluster:
+    """A scheduler and two single-threaded worker processes, started as a user would, with the ``dask`` command."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.file = folder / f"scheduler-{time.monotonic_ns()}.json"
+        dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+        self.scheduler = subprocess.Popen([*dask, "--scheduler-file", str(self.file), "--port", "0",
+                                           "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                          start_new_session=True)
+        wait_for(lambda: self.file.exists() and self.file.stat().st_size > 0, "the scheduler's file", 60)
+        self.address = json.loads(self.file.read_text())["address"]
+        self.workers = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                          "--scheduler-file", str(self.file), "--nthreads", "1", "--no-dashboard"],
+                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                         start_new_session=True, cwd=folder)
+                        for _ in range(2)]
+
+    def worker_processes(self) -> list[int]:
+        """The worker processes proper (each nanny's child), where the tasks run."""
+        return sorted(c for w in self.workers for c in children(w.pid))
+
+    def close(self) -> None:
+        for proc in [*self.workers, self.scheduler]:
+            try:
+                os.killpg(proc.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            proc.wait()
+
+
+def start_on(config: Path, out: Path, scheduler: str, resume: bool) -> subprocess.Popen:
+    args = [sys.executable, "-m", "slidernet", "run", str(config), "--out", str(out), "--scheduler", scheduler,
+            "--no-progress", *(["--resume"] if resume else [])]
+    return subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+
+
+def fault_dask_worker(folder: Path, config: Path, reference: Path) -> tuple[bool, str]:
+    """Kill -9 one Dask worker once the run has saved work: Dask runs its tasks again; the same bits."""
+    cluster = DaskCluster(folder)
+    out = folder / "dask_worker"
+    try:
+        proc = start_on(config, out, cluster.address, resume=False)
+        wait_for(lambda: saved(out) or proc.poll() is not None, "the run's first save")
+        victims = cluster.worker_processes()
+        if proc.poll() is not None or not victims:
+            return False, f"the run ended (rc {proc.returncode}) before a worker could be killed"
+        os.kill(victims[0], signal.SIGKILL)
+        _, err = proc.communicate(timeout=600)
+    finally:
+        cluster.close()
+    if proc.returncode != 0:
+        return False, f"rc {proc.returncode}: {err.strip()[-600:]}"
+    differs = same_bits(out / "result.nc", reference)
+    return differs is None, differs or "a worker killed after the first save; the run finished, same bits"
+
+
+def fault_dask_scheduler(folder: Path, config: Path, reference: Path) -> tuple[bool, str]:
+    """Kill -9 the scheduler once the run has saved work: one line and exit 2; resumed on a new cluster."""
+    cluster = DaskCluster(folder)
+    out = folder / "dask_scheduler"
+    try:
+        proc = start_on(config, out, cluster.address, resume=False)
+        wait_for(lambda: saved(out) or proc.poll() is not None, "the run's first save")
+        if proc.poll() is not None:
+            return False, f"the run ended (rc {proc.returncode}) before the scheduler could be killed"
+        os.killpg(cluster.scheduler.pid, signal.SIGKILL)
+        _, err = proc.communicate(timeout=600)
+    finally:
+        cluster.close()
+    bad = one_line_error(err)
+    if proc.returncode != 2 or bad or "--resume" not in err:
+        return False, f"the scheduler's death gave rc {proc.returncode}: {bad or err.strip()[-600:]}"
+    cluster = DaskCluster(folder)
+    try:
+        proc = start_on(config, out, cluster.address, resume=True)
+        _, err = proc.communicate(timeout=600)
+    finally:
+        cluster.close()
+    if proc.returncode != 0:
+        return False, f"the resume on a new cluster gave rc {proc.returncode}: {err.strip()[-600:]}"
+    differs = same_bits(out / "result.nc", reference)
+    return differs is None, differs or "scheduler killed after the first save: one line, exit 2; resumed, same " \
+                                       "bits"
+
+
+def fault_shared_folder(folder: Path, config: Path, reference: Path) -> tuple[bool, str]:
+    """A run and a sweep in one folder, both orders: the second is refused while the first works; nothing lost."""
+    notes = []
+    for first in ("sweep", "run"):
+        out = folder / f"shared_{first}_first"
+        sweep = [sys.executable, "-m", "slidernet", "sweep", str(config), "--set", "seed=7,8", "--out", str(out),
+                 "--workers", "2", "--no-progress"]
+        run = [sys.executable, "-m", "slidernet", "run", str(config), "--out", str(out), "--workers", "2",
+               "--no-progress"]
+        a, b = (sweep, run) if first == "sweep" else (run, sweep)
+        proc = subprocess.Popen(a, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        lock = out / ".slidernet.lock"
+        wait_for(lambda lock=lock, proc=proc: lock.exists() or proc.poll() is not None, f"the {first}'s lock")
+        second = subprocess.run(b, capture_output=True, text=True, timeout=600)
+        _, err = proc.communicate(timeout=600)
+        if proc.returncode != 0:
+            return False, f"the {first} in the folder failed (rc {proc.returncode}): {err.strip()[-600:]}"
+        if second.returncode != 2 or one_line_error(second.stderr) or "in use" not in second.stderr:
+            return False, (f"the second job in the folder of a {first} gave rc {second.returncode}: "
+                           f"{second.stderr.strip()[-600:]}")
+        if first == "run":
+            differs = same_bits(out / "result.nc", reference)
+            if differs:
+                return False, f"the run's result changed: {differs}"
+        elif not (out / "sweep.json").exists():
+            return False, "the sweep's sweep.json is gone"
+        notes.append(f"{first} first: the other refused ({second.stderr.strip().splitlines()[-1][:80]}...)")
+    return True, "; ".join(notes)
+
+
+HANG_PLUGIN = """\"\"\"gaussian_steps; it never returns once a file HANG is in its working folder.\"\"\"
+import os
+import time
+
+import slidernet
+from slidernet.plugins.drivers import GaussianSteps
+
+
+class MaybeHanging(GaussianSteps):
+    def thetas(self, rng, steps):
+        if os.path.exists("HANG"):
+            open(f"hanging-{os.getpid()}", "w").close()
+            while True:
+                time.sleep(3600)
+        return super().thetas(rng, steps)
+
+
+slidernet.register_driver("maybe_hanging", MaybeHanging)
+"""
+
+
+def fault_hanging_plugin(folder: Path, config: Path, group: bool) -> tuple[bool, str]:
+    """A driver that never returns: one SIGTERM (to the main process, or to the group) stops the run within
+    seconds, with one line and exit 143; resumed without the hang, the run gives the bits of a run that never
+    hung."""
+    work = folder / f"hang_{'group' if group else 'main'}"
+    work.mkdir()
+    (work / "hang_plugin.py").write_text(HANG_PLUGIN)
+    text = config.read_text().replace('name = "gaussian_steps"', 'name = "maybe_hanging"')
+    text = 'plugins = ["hang_plugin.py"]\n' + text.replace("[execution]", "[execution]\nstop_timeout = 5")
+    (work / "hang.toml").write_text(text)
+
+    def start_here(out: str, resume: bool = False) -> subprocess.Popen:
+        args = [sys.executable, "-m", "slidernet", "run", "hang.toml", "--out", out, "--workers", "2",
+                "--no-progress", *(["--resume"] if resume else [])]
+        return subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=work,
+                                start_new_session=True)
+
+    plain = start_here("plain")
+    _, err = plain.communicate(timeout=600)
+    if plain.returncode != 0:
+        return False, f"the run without the hang failed (rc {plain.returncode}): {err.strip()[-600:]}"
+    (work / "HANG").touch()
+    proc = start_here("hung")
+    wait_for(lambda: any(work.glob("hanging-*")) or proc.poll() is not None, "the plugin to hang")
+    t0 = time.monotonic()
+    (os.killpg if group else os.kill)(proc.pid, signal.SIGTERM)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        return False, "one SIGTERM did not stop a run whose plugin never returns within 60 s"
+    took = time.monotonic() - t0
+    bad = one_line_error(err)
+    if proc.returncode != 128 + signal.SIGTERM or bad:
+        return False, f"SIGTERM gave rc {proc.returncode}: {bad or err.strip()[-600:]}"
+    (work / "HANG").unlink()
+    again = start_here("hung", resume=True)
+    _, err = again.communicate(timeout=600)
+    if again.returncode != 0:
+        return False, f"the resume failed (rc {again.returncode}): {err.strip()[-600:]}"
+    differs = same_bits(work / "hung" / "result.nc", work / "plain" / "result.nc")
+    return differs is None, differs or (f"stopped {took:.1f} s after one SIGTERM (to the "
+                                        f"{'group' if group else 'main process'}), exit 143; resumed, same bits")
+
+
+FAULTS = ("kills", "dask-worker", "dask-scheduler", "folder", "hang")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=int, default=24)
     parser.add_argument("--kills", type=int, default=3, help="at most this many kills per trial (default 3)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random delays and kill counts")
+    parser.add_argument("--faults", default="kills", help="comma-separated, among " + ", ".join(FAULTS)
+                        + " or 'all' (default: kills)")
+    parser.add_argument("--fuzz", type=int, default=0, metavar="N",
+                        help="also run N cases of the configuration fuzz (benchmarks/config_fuzz.py)")
     parser.add_argument("--keep", type=Path, help="work in this folder and keep it (default: a temporary one)")
     args = parser.parse_args()
     if not sys.platform.startswith("linux"):
         print("fault_injection.py reads /proc: Linux only.", file=sys.stderr)
         return 2
+    faults = FAULTS if args.faults == "all" else tuple(f for f in args.faults.split(",") if f)
+    unknown = sorted(set(faults) - set(FAULTS))
+    if unknown:
+        print(f"unknown faults {unknown}; among {', '.join(FAULTS)}", file=sys.stderr)
+        return 2
     rng = random.Random(args.seed)
+    failures = 0
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.keep or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
@@ -199,18 +421,38 @@ def main() -> int:
             return 1
         span = time.monotonic() - t0
         reference = folder / "reference" / "result.nc"
-        print(f"uninterrupted run: {span:.1f} s; {args.trials} trials, up to {args.kills} kills each, seed "
-              f"{args.seed}")
-        failures = 0
-        killed = {mode: 0 for mode in MODES}
-        for k in range(args.trials):
-            mode = MODES[k % len(MODES)]
-            ok, what = trial(k, mode, rng, config, folder, reference, span, args.kills)
-            failures += not ok
-            killed[mode] += what.count(f"{mode} killed at ")
-            print(f"{k:3d} {mode:7s} {'ok  ' if ok else 'FAIL'} {what}", flush=True)
-        print(f"{args.trials - failures} of {args.trials} trials passed; kills delivered: "
-              + ", ".join(f"{n} of the {mode}" for mode, n in killed.items()))
+        print(f"uninterrupted run: {span:.1f} s")
+        if "kills" in faults:
+            print(f"{args.trials} trials, up to {args.kills} kills each, seed {args.seed}")
+            killed = {mode: 0 for mode in MODES}
+            for k in range(args.trials):
+                mode = MODES[k % len(MODES)]
+                ok, what = trial(k, mode, rng, config, folder, reference, span, args.kills)
+                failures += not ok
+                killed[mode] += what.count(f"{mode} killed at ")
+                print(f"{k:3d} {mode:7s} {'ok  ' if ok else 'FAIL'} {what}", flush=True)
+            print("kills delivered: " + ", ".join(f"{n} of the {mode}" for mode, n in killed.items()))
+        scenarios = {
+            "dask-worker": lambda: [fault_dask_worker(folder, config, reference)],
+            "dask-scheduler": lambda: [fault_dask_scheduler(folder, config, reference)],
+            "folder": lambda: [fault_shared_folder(folder, config, reference)],
+            "hang": lambda: [fault_hanging_plugin(folder, config, group=False),
+                             fault_hanging_plugin(folder, config, group=True)],
+        }
+        for name in faults:
+            for ok, what in scenarios[name]() if name != "kills" else []:
+                failures += not ok
+                print(f"{name:15s} {'ok  ' if ok else 'FAIL'} {what}", flush=True)
+        if args.fuzz:
+            import config_fuzz  # beside this script
+
+            root = folder / "fuzz"
+            root.mkdir()
+            config_fuzz.warm(root, 1)
+            done = config_fuzz.fuzz(args.fuzz, args.seed, 2, 60.0, 30.0, root)
+            print(config_fuzz.summary(done))
+            failures += sum(not c.ok for c in done)
+        print(f"{failures} failure(s)")
         return 1 if failures else 0
 
 
