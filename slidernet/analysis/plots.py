@@ -50,7 +50,6 @@ from matplotlib.lines import Line2D
 from slidernet.analysis import theory
 from slidernet.errors import ConfigError, ResultError, SlidernetError
 from slidernet.io import read_result, result_config, save_figure
-from slidernet.io.store import FolderLock
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -402,10 +401,9 @@ def save_network_pictures(ds: xr.Dataset, out_dir: str | os.PathLike[str], *, dp
     out.mkdir(parents=True, exist_ok=True)
     net = network_of(ds)
     paths = {}
-    with FolderLock(out, "plot"):  # the folder's one lock: never while a run or a sweep works there
-        for name, draw in (("slip_map", slip_map), ("mu_s_field", mu_s_field)):
-            fig = draw(ds, 0, network=net)
-            paths[name] = save_figure(fig, out / f"{name}.png", dpi=dpi)
+    for name, draw in (("slip_map", slip_map), ("mu_s_field", mu_s_field)):
+        fig = draw(ds, 0, network=net)
+        paths[name] = save_figure(fig, out / f"{name}.png", dpi=dpi)
     return paths
 
 
@@ -731,9 +729,6 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     ConfigError
         Before anything is drawn or written: ``path`` has a suffix
         matplotlib cannot write.
-    FolderInUseError
-        Before the picture is written: another command (a run, a sweep)
-        works in the folder of ``path`` (it holds the folder's lock).
 
     Examples
     --------
@@ -802,8 +797,5 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     heading = name or ds.attrs.get("title", "slidernet result")
     fig.suptitle(heading if cfg_dict is None else f"{heading}: {_summary(cfg_dict, ds)}", fontsize=10)
     if path is not None:
-        folder = Path(path).parent
-        folder.mkdir(parents=True, exist_ok=True)
-        with FolderLock(folder, "plot"):  # the folder's one lock: never while a run or a sweep works there
-            save_figure(fig, path, dpi=dpi)
+        save_figure(fig, path, dpi=dpi)
     return fig

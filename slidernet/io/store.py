@@ -2,9 +2,9 @@
 
 One lock per output folder, whatever writes into it: a run (and its
 resume), a sweep (and each of its points, in its point's folder), the
-paper's reproduction and a plot (while it writes its picture) take the
-folder's :class:`FolderLock`, ``DIR/.slidernet.lock``, before they write
-anything there, and refuse a folder whose lock another process holds. Each
+paper's reproduction and ``slidernet plot`` (while it makes its picture)
+take the folder's :class:`FolderLock`, ``DIR/.slidernet.lock``, before they
+write anything there, and refuse a folder whose lock another process holds. Each
 kind of output keeps to its own folders: a run never writes into a folder
 that holds a sweep or a paper reproduction, nor they into a run's
 (:func:`check_own_folder`; ``--overwrite`` replaces only the files of its
