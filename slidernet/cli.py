@@ -255,8 +255,16 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             raise ConfigError(f"--show needs a window, and matplotlib's backend {backend!r} cannot open one "
                               "(no display?); write a file instead (--out PATH), or set MPLBACKEND.")
         figure = plt.figure()
-    plot_result(args.result, out, figure=figure)
-    if out is not None:
+    if out is None:
+        plot_result(args.result, None, figure=figure)
+    else:
+        # The one lock of the picture's folder while the picture is made: never beside a run or a sweep
+        # still going there (a run's own folder is where RESULT.png goes by default).
+        from slidernet.io.store import FolderLock
+
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with FolderLock(out.parent, "plot"):
+            plot_result(args.result, out, figure=figure)
         print(f"wrote {out}")
     if args.show:
         plt.show()

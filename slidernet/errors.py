@@ -68,7 +68,7 @@ class OutputError(SlidernetError, OSError):
 
 
 class FolderInUseError(OutputError):
-    """An output folder is locked by a run that is still going (another process holds its lock)."""
+    """An output folder is locked by a command still going there (a run, a sweep, the paper, a plot)."""
 
 
 class WorkerLostError(SlidernetError, RuntimeError):

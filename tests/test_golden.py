@@ -19,7 +19,7 @@ from slidernet.io import read_result
 from .golden.make_golden import HERE, NAMES, make
 
 # Attributes that may change without a change of results.
-VOLATILE = {"slidernet_version", "execution"}
+VOLATILE = {"slidernet_version", "slidernet_code", "execution"}
 
 
 @pytest.mark.parametrize("case", NAMES)

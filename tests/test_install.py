@@ -72,12 +72,13 @@ def test_each_version_of_the_kernels_sources_has_its_own_cache_folder(tmp_path):
     # anywhere in kernels/ must lead to another folder (tests/test_compile.py runs the whole story).
     import shutil
 
+    from slidernet._version import folder_digest
     from slidernet.kernels import jit
 
     copy = tmp_path / "kernels"
     shutil.copytree(Path(jit.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    assert jit.folder_digest(copy) == jit.sources_digest()
+    assert folder_digest(copy)[:16] == jit.sources_digest()
     assert jit.cache_dir().endswith(jit.sources_digest())
     heap = copy / "heap.py"
     heap.write_text(heap.read_text() + "\n# an edit\n")
-    assert jit.folder_digest(copy) != jit.sources_digest()
+    assert folder_digest(copy)[:16] != jit.sources_digest()

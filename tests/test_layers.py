@@ -2,7 +2,8 @@
 
 Stages, from the bottom up (ARCHITECTURE.md draws the same map):
 
-0. ``errors``, ``_validation``, ``_version``: exceptions and shared input checks;
+0. ``errors``, ``_validation``, ``_version``, ``_paths``: exceptions, shared input checks, the version and
+   the digest of the code, paths;
 1. ``kernels``: the compiled loops (numba), which import nothing else;
 2. ``model``: networks, their builders, physical units;
 3. ``plugins``: distributions of mu_s, drivers, their registry and contract;
@@ -27,8 +28,8 @@ import pytest
 import slidernet
 
 ROOT = Path(slidernet.__file__).parent
-RANK = {"errors": 0, "_validation": 0, "_version": 0, "kernels": 1, "model": 2, "plugins": 3, "config": 4,
-        "solver": 5, "io": 6, "analysis": 7, "ensemble": 8, "paper": 9, "validation": 9,
+RANK = {"errors": 0, "_validation": 0, "_version": 0, "_paths": 0, "kernels": 1, "model": 2, "plugins": 3,
+        "config": 4, "solver": 5, "io": 6, "analysis": 7, "ensemble": 8, "paper": 9, "validation": 9,
         "__init__": 10, "__main__": 10, "cli": 10, "testing": 10}
 
 

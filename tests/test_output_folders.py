@@ -10,9 +10,11 @@
 from __future__ import annotations
 
 import hashlib
+import importlib
 import json
 import os
 import re
+import secrets
 import shutil
 import subprocess
 import sys
@@ -204,7 +206,7 @@ def test_a_block_renamed_on_a_name_collision_is_still_read(tmp_path):
     from slidernet.io.store import RunStore
 
     store = RunStore(tmp_path, {"config": {}, "seed": 1, "realizations": 3, "slidernet_version": "x",
-                                "inputs": {}}, resume=False)
+                                "slidernet_code": "y", "inputs": {}}, resume=False)
     store.open()
 
     def record(r: int) -> dict:
@@ -347,16 +349,50 @@ def _input_case(case: str, folder: Path) -> tuple[dict, Path, Callable[[], None]
         cfg = _with(base, steps=100, driver={"name": "series", "path": str(path), "kappa": 1.2e-5, "T0": 15.0,
                                              "tau_th": 1.0})
         return cfg, path, lambda: path.write_text(path.read_text().replace("\n0,10.30", "\n0,10.40"))
+    if case.startswith("plugin-"):
+        return _helper_case(case, folder, base)
     path = _law_file(folder, 0.65)
     cfg = _with(base, plugins=[str(path)], **{"friction.static": {"name": "flat_for_test"}})
     return cfg, path, lambda: _law_file(folder, 0.66)
 
 
+def _helper_case(case: str, folder: Path, base: dict) -> tuple[dict, Path, Callable[[], None]]:
+    """A plugin file whose law's upper end comes from a module beside it (or from a module that one imports).
+
+    The module names are new to this process (a module imported once stays in ``sys.modules``); with
+    ``-imported-before`` this process imports the helper before the plugin file is imported.
+    """
+    helper = f"helper_{secrets.token_hex(4)}"
+    inner = f"{helper}_inner"
+    (folder / f"{inner}.py").write_text("HIGH = 0.65\n")
+    (folder / f"{helper}.py").write_text(f"from {inner} import HIGH\n" if case == "plugin-helper-of-helper"
+                                         else "HIGH = 0.65\n")
+    law = folder / "law_with_helper.py"
+    law.write_text("import sys\nfrom pathlib import Path\n\nimport numpy as np\nimport slidernet\n\n"
+                   "sys.path.insert(0, str(Path(__file__).parent))\n"
+                   f"from {helper} import HIGH  # noqa: E402\n\n\n"
+                   "class Flat:\n    def sample(self, rng, size):\n"
+                   "        return rng.uniform(0.55, HIGH, size)\n\n"
+                   "    def cdf(self, x):\n"
+                   "        return np.clip((np.asarray(x) - 0.55) / (HIGH - 0.55), 0.0, 1.0)\n"
+                   "\n\nslidernet.register_distribution('flat_helper_for_test', Flat)\n")
+    if case == "plugin-helper-imported-before":
+        sys.path.insert(0, str(folder))
+        importlib.import_module(helper)
+    cfg = _with(base, plugins=[str(law)], **{"friction.static": {"name": "flat_helper_for_test"}})
+    edited = folder / f"{inner if case == 'plugin-helper-of-helper' else helper}.py"
+    return cfg, edited, lambda: edited.write_text(edited.read_text().replace("0.65", "0.66"))
+
+
 @pytest.mark.usefixtures("clean_registries")
-@pytest.mark.parametrize("case", ["graph", "graph-nodes", "empirical", "series", "plugin"])
-def test_an_input_file_changed_before_resume_is_refused(tmp_path, case):
+@pytest.mark.parametrize("case", ["graph", "graph-nodes", "empirical", "series", "plugin", "plugin-helper",
+                                  "plugin-helper-of-helper", "plugin-helper-imported-before"])
+def test_an_input_file_changed_before_resume_is_refused(tmp_path, case, monkeypatch):
     # kind = "graph" from an edge list, 16 realizations: kill after a few, change one spring's k, resume.
     # The run used to go on (exit 0), realizations 0-8 with the old network and 9-15 with the new one.
+    # A module that a plugin file imports (helper.py beside it) was not hashed: a changed helper was
+    # resumed with exit 0, realizations half old law and half new.
+    monkeypatch.setattr(sys, "path", list(sys.path))  # a plugin file may put its folder on it
     cfg, path, edit = _input_case(case, tmp_path)
     out = tmp_path / "out"
     _stopped_after(cfg, out, 9)
@@ -365,6 +401,21 @@ def test_an_input_file_changed_before_resume_is_refused(tmp_path, case):
                                               rf"'{re.escape(str(path))}'"):
         slidernet.run(cfg, out=out, resume=True)
     assert len(list((out / "checkpoint").glob("block-*"))) == 1  # nothing was touched
+
+
+@pytest.mark.usefixtures("clean_registries")
+def test_the_modules_a_plugin_file_brings_in_are_input_files_and_installed_ones_are_not(tmp_path, monkeypatch):
+    from slidernet.config import load_config
+    from slidernet.config.loading import input_files
+
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    cfg, inner, _ = _input_case("plugin-helper-of-helper", tmp_path)
+    helper = inner.with_name(inner.name.replace("_inner", ""))
+    files = input_files(load_config(cfg))
+    # numpy and slidernet, which the file imports too, are the environment's: not listed.
+    assert files == {"plugins[0]": cfg["plugins"][0],
+                     f"plugins[0] imports {helper.stem}": str(helper),
+                     f"plugins[0] imports {inner.stem}": str(inner)}
 
 
 def test_the_input_files_are_in_the_result_and_an_unchanged_one_resumes(tmp_path):
@@ -439,6 +490,89 @@ def test_a_damaged_run_json_is_one_line(tmp_path, capsys, text):
     assert str(run_json) in line and "--overwrite" in line
 
 
+@pytest.mark.parametrize("command", ["run", "sweep", "paper"])
+@pytest.mark.parametrize("kind", ["dangling-symlink", "symlink-loop", "symlink-to-a-file"])
+def test_a_symbolic_link_that_is_no_folder_is_named_for_what_it_is(tmp_path, config, capsys, kind, command):
+    # A dangling symbolic link or a loop as --out was called "a file".
+    out = tmp_path / "link"
+    target = {"dangling-symlink": tmp_path / "nowhere", "symlink-loop": out,
+              "symlink-to-a-file": tmp_path / "afile"}[kind]
+    (tmp_path / "afile").write_text("x")
+    out.symlink_to(target)
+    argv = {"run": ["run", str(config)], "sweep": ["sweep", str(config), "--set", "driver.sigma_theta=1e-6,2e-6"],
+            "paper": ["paper"]}[command]
+    line = _one_line_error(capsys, main([*argv, "--out", str(out), "--no-progress"]))
+    expected = {"dangling-symlink": f"is a symbolic link to {str(target)!r}, which does not exist",
+                "symlink-loop": "is a symbolic link in a loop of links, which never reaches a folder",
+                "symlink-to-a-file": f"is a symbolic link to the file {str(target)!r}"}[kind]
+    assert line == f"slidernet: error: The output directory {str(out)!r} {expected}; name a folder."
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "link", "small.toml"]
+    assert not (tmp_path / "nowhere").exists()
+
+
+def test_a_dangling_symbolic_link_inside_the_output_path_is_named(tmp_path, config, capsys):
+    (tmp_path / "link").symlink_to(tmp_path / "nowhere")
+    out = tmp_path / "link" / "out"
+    line = _one_line_error(capsys, main(["run", str(config), "--out", str(out), "--no-progress"]))
+    link, nowhere = str(tmp_path / "link"), str(tmp_path / "nowhere")
+    assert line == (f"slidernet: error: The output directory {str(out)!r} cannot be made: {link!r} is a symbolic "
+                    f"link to {nowhere!r}, which does not exist.")
+
+
+# A name that is not UTF-8 text: the byte 0xff, as a shell hands it to Python (surrogateescape).
+NOT_UTF8 = os.fsdecode(b"caf\xe9")
+
+
+@pytest.mark.parametrize("command", ["run", "sweep", "paper"])
+def test_an_output_folder_whose_name_is_not_utf8_is_refused_before_any_work(tmp_path, config, capsys,
+                                                                           monkeypatch, command):
+    # It failed after the whole run, in the netCDF library, with a UnicodeEncodeError traceback (exit 1).
+    from slidernet.ensemble import runner
+    from slidernet.paper import reproduction
+
+    monkeypatch.setattr(runner, "compile_kernels", _no_work)
+    monkeypatch.setattr(reproduction, "compile_kernels", _no_work)
+    out = tmp_path / NOT_UTF8
+    argv = {"run": ["run", str(config)], "sweep": ["sweep", str(config), "--set", "driver.sigma_theta=1e-6,2e-6"],
+            "paper": ["paper"]}[command]
+    line = _one_line_error(capsys, main([*argv, "--out", str(out), "--no-progress"]))
+    assert line == (f"slidernet: error: The output directory {str(out)!r} is not UTF-8 text: its byte 0xe9 "
+                    "cannot be decoded, and netCDF files are named in UTF-8. Rename it, or name another folder.")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]
+
+
+def _no_work(*args, **kwargs):
+    raise AssertionError("work started")
+
+
+@pytest.mark.usefixtures("clean_registries")
+@pytest.mark.parametrize("where", ["plugin", "data"])
+def test_an_input_path_that_is_not_utf8_is_refused_before_any_work(tmp_path, capsys, where):
+    # A plugin file in such a folder gave a UnicodeEncodeError traceback (exit 1). A configuration holds
+    # text, its paths included: each is refused by its field, as the validation refuses the graph's.
+    from slidernet.plugins.contract import example_file
+
+    folder = tmp_path / NOT_UTF8
+    folder.mkdir()
+    config = folder / "small.toml"  # a TOML file is UTF-8 text: the name comes from the file's folder
+    if where == "plugin":
+        path = _law_file(folder, 0.65)
+        config.write_text('plugins = ["my_law.py"]\n'
+                          + SMALL.replace('name = "gaussian"\nmean = 0.6\nstd = 0.01', 'name = "flat_for_test"'))
+        field = "'plugins' field"
+    else:
+        path = folder / "mu_s.txt"
+        shutil.copy(example_file("mu_s_example.txt"), path)
+        config.write_text(SMALL.replace('name = "gaussian"\nmean = 0.6\nstd = 0.01',
+                                        'name = "empirical"\npath = "mu_s.txt"'))
+        field = "'friction.static.path' field"
+    out = tmp_path / "out"
+    line = _one_line_error(capsys, main(["run", str(config), "--out", str(out), "--no-progress"]))
+    assert line == (f"slidernet: error: The {field}: {str(path)!r} is not UTF-8 text: its byte 0xe9 cannot be "
+                    "decoded, and a configuration and its result name their files in text. Rename the folder, or "
+                    "move the file.")
+    assert not out.exists()
+
 def _toml(cfg: dict) -> str:
     """A configuration as TOML (tables of plain values)."""
     def value(v):
@@ -469,7 +603,7 @@ def test_resume_names_an_empty_checkpoint_folder(tmp_path):
 _HOLD_LOCK = """\
 import sys
 from slidernet.io.store import FolderLock
-FolderLock(sys.argv[1]).acquire()
+FolderLock(sys.argv[1], "run").acquire()
 print("locked", flush=True)
 sys.stdin.read()
 """
@@ -488,7 +622,7 @@ def interrupted_and_locked(tmp_path) -> Iterator[tuple[Path, subprocess.Popen]]:
     """An interrupted run in ``tmp_path / "out"``, whose lock another process holds."""
     out = tmp_path / "out"
     _stopped_after(CHAIN8, out, 1)
-    holder = _hold_lock(out / "checkpoint")
+    holder = _hold_lock(out)
     yield out, holder
     holder.kill()
     holder.wait()
@@ -511,7 +645,7 @@ def test_a_lock_dies_with_its_process(interrupted_and_locked, chain8_reference):
     out, holder = interrupted_and_locked
     holder.kill()  # kill -9: the operating system lets the lock go
     holder.wait()
-    assert (out / "checkpoint" / ".slidernet.lock").exists()
+    assert (out / ".slidernet.lock").exists()
     with slidernet.run(CHAIN8, out=out, resume=True) as ds:
         _assert_same_bits(ds.load(), chain8_reference)
     assert _tree(out) == ["result.nc"]  # the lock file goes with its run

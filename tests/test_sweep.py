@@ -366,9 +366,9 @@ def test_a_sweep_still_going_is_not_touched(tmp_path):
     grid = {"driver.sigma_theta": [1e-7, 1e-6]}
     sweep(BASE, grid, out=tmp_path, **ONE)
     before = sorted(p.name for p in tmp_path.rglob("*"))
-    with FolderLock(tmp_path):  # held as the sweep still going holds it
+    with FolderLock(tmp_path, "sweep"):  # held as the sweep still going holds it
         for flags in ({"overwrite": True}, {"resume": True}):
-            with pytest.raises(FolderInUseError, match="a slidernet run is still going there"):
+            with pytest.raises(FolderInUseError, match="a slidernet sweep is still going there"):
                 sweep(BASE, grid, out=tmp_path, **flags, **ONE)
     assert sorted(p.name for p in tmp_path.rglob("*")) == before
 

@@ -11,6 +11,7 @@ reason.
 
 from __future__ import annotations
 
+import copy
 import math
 import sys
 from collections.abc import Mapping
@@ -19,12 +20,13 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from slidernet._paths import absolute_path, not_utf8
 from slidernet.config.base import NOT_INTEGER, NOT_REAL
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
 from slidernet.model.builders import graph_files
 from slidernet.model.network import Network
-from slidernet.plugins.loader import absolute_entry, import_plugins, is_file_entry
+from slidernet.plugins.loader import absolute_entry, import_plugins, plugin_sources
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -62,12 +64,12 @@ def _describe(err: Mapping[str, Any]) -> str:
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
-    """A configuration file as a dict, not validated; relative file paths made relative to the file.
+    """A configuration file as a dict, not validated; relative file paths made absolute against the file's folder.
 
     Files named in a config file (a graph, a temperature series, measured
     thresholds, the ``.py`` files of ``plugins``) are found next to that
-    file. A plugin file's path is made absolute, so that a worker that
-    starts elsewhere (Dask) imports the same file.
+    file. Their paths are made absolute (:func:`anchored`), so that a worker
+    that starts elsewhere (Dask) reads the same files.
     """
     path = Path(path)
     where = f"The configuration file {str(path)!r}"
@@ -88,14 +90,46 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         ) from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{where} is not valid TOML: {exc}") from None
-    for table in _path_tables(source).values():
-        named = Path(table["path"])
-        if not named.is_absolute():
-            table["path"] = str(path.parent / named)
+    return anchored(source, path.parent)
+
+
+def anchored(source: Mapping[str, Any], base: str | Path) -> dict[str, Any]:
+    """A copy of a raw configuration whose file paths are absolute, a relative one taken against ``base``.
+
+    The data files of :func:`_path_tables` and the ``.py`` files of
+    ``plugins``; anything else (a value that is not a path) is left to the
+    validation, which names it. Every path a run hands to its workers is
+    then absolute, resolved in the process that read the configuration.
+
+    Raises
+    ------
+    ConfigError
+        If a path, once anchored, is not UTF-8 text (a folder named with a
+        byte that is not UTF-8, :func:`slidernet._paths.not_utf8`): a
+        configuration and the result that records it are text. Naming the
+        field.
+
+    >>> anchored({"plugins": ["laws.py", "my_package.laws"], "network": {"kind": "graph", "path": "g.txt"}},
+    ...          "/home/me")
+    {'plugins': ['/home/me/laws.py', 'my_package.laws'], 'network': {'kind': 'graph', 'path': '/home/me/g.txt'}}
+    """
+    source = copy.deepcopy(dict(source))
+    for name, table in _path_tables(source).items():
+        table["path"] = _text_path(absolute_path(table["path"], base), f"{name}.path")
     plugins = source.get("plugins")
     if isinstance(plugins, list):  # anything else is refused, by name, when it is validated
-        source["plugins"] = [absolute_entry(e, path.parent) if isinstance(e, str) else e for e in plugins]
+        source["plugins"] = [_text_path(absolute_entry(e, base), "plugins") if isinstance(e, str) else e
+                             for e in plugins]
     return source
+
+
+def _text_path(path: str, field: str) -> str:
+    """``path``, refused (naming ``field``) if it is not UTF-8 text."""
+    why = not_utf8(path)
+    if why is not None:
+        raise ConfigError(f"The {field!r} field: {path!r} {why}, and a configuration and its result name their "
+                          "files in text. Rename the folder, or move the file.")
+    return path
 
 
 def _path_tables(source: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
@@ -125,11 +159,13 @@ def input_files(cfg: Config) -> dict[str, str]:
     dict of str to str
         ``"network.path"``, ``"driver.path"``, ``"friction.static.path"``
         (where given), ``"network.path (node file)"`` (the companion node
-        file of an edge list) and ``"plugins[i]"`` for each entry of
-        ``plugins`` that is a ``.py`` file, to the path as the configuration
-        holds it (a relative one is relative to the current directory, where
-        it is read). A plugin given as a module name is not a file of the
-        configuration and is not listed.
+        file of an edge list), ``"plugins[i]"`` for each entry of
+        ``plugins`` that is a ``.py`` file or a module of the user's, and
+        ``"plugins[i] imports NAME"`` for each module outside the
+        environment that entry brings in
+        (:func:`slidernet.plugins.loader.plugin_sources`), each file listed
+        once, to its path. A plugin installed in the environment's
+        site-packages is not listed: its version is the user's to keep.
     """
     dumped = cfg.model_dump(mode="json")
     files = {f"{name}.path": table["path"] for name, table in _path_tables(dumped).items()}
@@ -138,8 +174,12 @@ def input_files(cfg: Config) -> dict[str, str]:
         if nodes is not None:
             files["network.path (node file)"] = str(nodes)
     for i, entry in enumerate(cfg.plugins or ()):
-        if is_file_entry(entry):
-            files[f"plugins[{i}]"] = entry
+        own, imports = plugin_sources(entry)
+        if own is not None:
+            files[f"plugins[{i}]"] = own
+        for name, path in imports.items():
+            if path not in files.values():  # a helper two plugins share is listed once, under the first
+                files[f"plugins[{i}] imports {name}"] = path
     return files
 
 
@@ -154,9 +194,10 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     ----------
     source : Config, mapping, or path
         A :class:`Config`, a dict with the keys of docs/model.md section 5, or the
-        path of a TOML file with those keys. A relative path under ``plugins``
-        is relative to the TOML file, or for a dict or a Config to the current
-        directory; a dict's is stored absolute.
+        path of a TOML file with those keys. A relative file path (under
+        ``plugins``, or a data file's ``path``) is relative to the TOML file,
+        or for a dict or a Config to the current directory; it is stored
+        absolute (:func:`anchored`).
 
     Returns
     -------
@@ -172,12 +213,18 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     if isinstance(source, (str, Path)):
         source = read_toml(source)
     if isinstance(source, Config):
+        dumped = source.model_dump(mode="json")
+        if anchored(dumped, Path.cwd()) != dumped:  # built with a relative path: validated again, anchored
+            source = dumped
+    if isinstance(source, Config):
         import_plugins(source.plugins or ())
         cfg = source
     else:
         if not isinstance(source, Mapping):
             raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
-        source = _import_listed_plugins(source)
+        # Absolute in the stored configuration: workers that start in another folder find the same files.
+        source = anchored(source, Path.cwd())
+        _import_listed_plugins(source)
         try:
             cfg = Config.model_validate(dict(source))
         except ValidationError as exc:
@@ -198,21 +245,16 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
     return cfg
 
 
-def _import_listed_plugins(source: Mapping[str, Any]) -> Mapping[str, Any]:
-    """Import the ``plugins`` of a raw configuration before it is validated; return it with their paths absolute.
+def _import_listed_plugins(source: Mapping[str, Any]) -> None:
+    """Import the ``plugins`` of a raw configuration (their paths absolute) before it is validated.
 
     Before validation, because the validators already look plugin names up
     (whether the driver takes ``sigma_theta``, for ``[units]``). A value that
     is not a list of strings is left to the validation, which names it.
     """
     plugins = source.get("plugins")
-    if not (isinstance(plugins, list) and all(isinstance(e, str) and e for e in plugins)):
-        return source
-    cwd = Path.cwd()
-    # Absolute in the stored configuration: workers that start in another folder find the same files.
-    absolute = [absolute_entry(e, cwd) for e in plugins]
-    import_plugins(absolute)
-    return {**source, "plugins": absolute}
+    if isinstance(plugins, list) and all(isinstance(e, str) and e for e in plugins):
+        import_plugins(plugins)
 
 
 def _check_incline_holds(cfg: Config) -> None:

@@ -14,7 +14,8 @@ import numpy as np
 import xarray as xr
 from tqdm.auto import tqdm
 
-from slidernet._version import __version__
+from slidernet._paths import absolute_path
+from slidernet._version import __version__, code_digest
 from slidernet.analysis.observables import CHUNK, assemble
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
 from slidernet.config.loading import input_files
@@ -30,7 +31,7 @@ from slidernet.errors import (
 )
 from slidernet.io import read_result
 from slidernet.io.netcdf import open_result
-from slidernet.io.store import RunStore, changed_inputs, file_digest
+from slidernet.io.store import RunStore, changed_code, changed_inputs, file_digest
 from slidernet.solver import budget
 from slidernet.solver.compile import compile_kernels, terminal_notice
 
@@ -56,12 +57,15 @@ def identity(requested: Config, resolved: Config) -> dict[str, Any]:
     """What a checkpoint must match to be resumed (``io.store.IDENTITY_KEYS``).
 
     The configuration without its execution table, the seed, the number of
-    realizations, the slidernet version and the SHA-256 of every input file
-    (a graph, a temperature series, measured thresholds, plugin files).
+    realizations, the slidernet version and the digest of its sources
+    (:func:`slidernet._version.code_digest`), and the SHA-256 of every input
+    file (a graph, a temperature series, measured thresholds, plugin files
+    and the modules they bring in from outside the environment's
+    site-packages).
     """
     config = requested.model_dump(mode="json", exclude={"execution"})
     return {"config": config, "seed": resolved.seed, "realizations": resolved.realizations,
-            "slidernet_version": __version__, "inputs": input_digests(requested)}
+            "slidernet_version": __version__, "slidernet_code": code_digest(), "inputs": input_digests(requested)}
 
 
 #: What each value of a scene's ``tilt_at`` measures: the ``mu_eff_estimator`` attribute of a result.
@@ -80,6 +84,7 @@ def _attrs(cfg: Config, scene: Any, workers: int, scheduler: str | None,
         "inputs": json.dumps(inputs, sort_keys=True),
         "execution": json.dumps({"workers": workers, "scheduler": scheduler}),
         "slidernet_version": __version__,
+        "slidernet_code": code_digest(),
         "seed": str(cfg.seed),
         "kernel": scene.kernel,
         "Conventions": "CF-1.8",
@@ -122,6 +127,11 @@ def run(
         realizations) and the run checkpoints its work under
         ``out/checkpoint/`` every ``execution.checkpoint_every`` seconds and
         on Ctrl-C. The returned dataset is then opened lazily from the file.
+        A relative path is relative to the current directory of this
+        process, never to a worker's. The run holds the folder's lock
+        (``out/.slidernet.lock``) from before it writes anything until it
+        ends, and never writes into a folder that holds a sweep or a paper
+        reproduction.
     resume : bool
         Continue the interrupted run in ``out`` (same configuration; the
         execution table may differ). The result is the bits of an
@@ -145,7 +155,9 @@ def run(
         Variables ``n``, ``mu_max``, ``x_G`` (realization, t) and ``mu_eff``
         (t) as requested, with ensemble means and standard errors; attributes
         ``config`` (the resolved configuration as JSON), ``slidernet_version``,
-        ``seed``, ``kernel`` and ``execution``; with ``mu_eff``, also
+        ``slidernet_code`` (the digest of slidernet's sources), ``inputs``
+        (every input file's path and SHA-256), ``seed``, ``kernel`` and
+        ``execution``; with ``mu_eff``, also
         ``mu_eff_at`` (``"rearrangements"`` or ``"records"``, what
         ``mu_eff_at = "auto"`` resolved to) and ``mu_eff_estimator`` (the
         test in words).
@@ -163,8 +175,11 @@ def run(
         state of the running ones are saved; its message says how to resume
         and its ``signum`` which signal stopped the run.
     OutputError
-        If ``out`` cannot be used as a folder, or holds a finished result
-        and ``overwrite`` is not set.
+        If ``out`` cannot be used as a folder, holds a sweep or a paper
+        reproduction, or holds a finished result and ``overwrite`` is not
+        set.
+    FolderInUseError
+        If another command works in ``out`` (it holds the folder's lock).
     SchedulerError
         If the Dask scheduler does not answer within
         ``execution.scheduler_timeout`` seconds.
@@ -212,6 +227,9 @@ def run(
     run_identity = identity(requested, cfg)
     store = None
     if out is not None:
+        # Absolute here, in this process: the workers' partial files are named from it, and a Dask worker
+        # starts in its own working folder.
+        out = Path(absolute_path(out, Path.cwd()))
         store = RunStore(out, run_identity, resume, overwrite=overwrite)
         seed = store.open()  # holds the folder's lock until store.close()
         if seed != cfg.seed:  # a resumed run whose config left the seed to fresh entropy
@@ -224,7 +242,7 @@ def run(
         if store is None:
             ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
         else:
-            path = write_result_stream(store.records(R), Path(out) / "result.nc", scene.out_steps, R,
+            path = write_result_stream(store.records(R), out / "result.nc", scene.out_steps, R,
                                        list(cfg.observables), attrs)
             store.remove()
             ds = open_result(path)
@@ -351,7 +369,8 @@ def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, 
     """One run kept in its own folder, as a step of a larger job (a sweep point, a paper figure).
 
     With ``resume``, a finished run (``out/result.nc`` and no checkpoint) is
-    read back, after checking that it holds this configuration; an
+    read back, after checking that it was computed from this configuration,
+    these input files and this code (version and digest of the sources); an
     interrupted one is resumed; a run not yet started starts. Without it the
     run starts, as :func:`run` does.
 
@@ -383,6 +402,10 @@ def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, 
         if json.loads(ds.attrs["config"]) != expected:
             raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} holds a run of another "
                                   "configuration than this one.")
+        code = changed_code(ds.attrs, {"slidernet_version": __version__, "slidernet_code": code_digest()})
+        if code:
+            raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} {code}; it would not be "
+                                  "bit-identical to what this code computes. Start again with --overwrite.")
         changed = changed_inputs(json.loads(ds.attrs.get("inputs", "{}")), input_digests(cfg))
         if changed:
             raise CheckpointError(f"Cannot resume: {str(out / 'result.nc')!r} was computed from other contents of "

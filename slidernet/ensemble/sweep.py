@@ -73,7 +73,7 @@ Per-node variables
     is the group of the point ``network.n = 8``.
 Attributes
     As a run's (``config``, the base configuration with its seed resolved,
-    ``slidernet_version``, ``seed``, ``kernel``, ``execution``: the last
+    ``slidernet_version``, ``slidernet_code``, ``seed``, ``kernel``, ``execution``: the last
     point's), plus ``sweep`` (the grid) and ``configs`` (every point's resolved configuration, C order). Where
     the points' kernels differ, ``kernel`` lists the distinct ones, comma
     separated, and ``kernels`` (JSON) gives each point's, in C order.
@@ -84,10 +84,14 @@ the combined result is written atomically to ``out/result.nc`` (a
 DataTree as netCDF4 groups, every group in the one result encoding;
 :func:`slidernet.io.read_result` reads back a Dataset or a DataTree, what
 was written).
-``out/sweep.json`` holds the base configuration, the grid and the resolved
-seed, so a killed sweep resumes point by point (``resume=True``): finished
-points are read back, the interrupted one continues from its checkpoints,
-the rest run; a sweep with another configuration or grid is refused there.
+``out/sweep.json`` holds the base configuration, the grid, the resolved
+seed, and slidernet's version and code digest, so a killed sweep resumes
+point by point (``resume=True``): finished points are read back, the
+interrupted one continues from its checkpoints, the rest run; a sweep with
+another configuration, grid or code is refused there. The sweep holds
+``out/.slidernet.lock`` while it works (each point its point folder's), and
+never works in a folder that holds a run or a paper reproduction
+(:func:`slidernet.io.store.check_own_folder`).
 """
 
 from __future__ import annotations
@@ -108,12 +112,12 @@ import numpy as np
 import xarray as xr
 from tqdm.auto import tqdm
 
-from slidernet._version import __version__
+from slidernet._version import __version__, code_digest
 from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted, SizeError
 from slidernet.io import atomic_output, write_netcdf
-from slidernet.io.store import check_output_dir, locked_folder, read_identity_file
+from slidernet.io.store import locked_folder, read_identity_file
 from slidernet.solver import Scene, budget, record_times
 
 if sys.version_info >= (3, 11):
@@ -314,7 +318,10 @@ def sweep(
     out : str or Path, optional
         Output folder: ``out/sweep.json``, point i in ``out/points/<i>/``,
         the result written atomically to ``out/result.nc``. A folder that
-        holds a sweep is refused unless ``resume`` or ``overwrite``.
+        holds a sweep is refused unless ``resume`` or ``overwrite``; one
+        that holds a run or a paper reproduction, whatever the flags. The
+        sweep holds the folder's lock (``out/.slidernet.lock``) from before
+        it writes anything until it ends, and each point its point's.
     resume : bool
         Continue the killed sweep in ``out``, point by point (same
         configuration and grid; the seed stored there).
@@ -333,8 +340,8 @@ def sweep(
         (sigma_theta,); attributes ``config`` (the base configuration as
         JSON, seed resolved), ``sweep`` (the grid as JSON), ``configs``
         (JSON list of every point's resolved configuration, in C order),
-        ``slidernet_version``, ``seed``, ``kernel`` and ``execution`` (the
-        runner's, of the last point). A DataTree where the numbers of
+        ``slidernet_version``, ``slidernet_code``, ``seed``, ``kernel`` and
+        ``execution`` (the runner's, of the last point). A DataTree where the numbers of
         nodes differ: that dataset without the per-node variables at its
         root, with the coordinate ``sweep_point``; point i's per-node
         variables, (realization, node), in its child ``point_<i>``.
@@ -345,7 +352,12 @@ def sweep(
         Before any work, naming the point and its keys, if a point's
         configuration is invalid or the points cannot be stacked.
     CheckpointError
-        If ``out`` holds another sweep, or (on resume) none.
+        If ``out`` holds another sweep, or (on resume) none, or a sweep of
+        another version or code of slidernet.
+    OutputError
+        If ``out`` is not a folder, or holds a run or a paper reproduction.
+    FolderInUseError
+        If another command works in ``out`` (it holds the folder's lock).
     RunInterrupted
         On Ctrl-C or SIGTERM, once the work done is saved (with ``out``);
         its message says how to resume.
@@ -383,8 +395,9 @@ def sweep(
                "scheduler": scheduler, "overwrite": overwrite, "scheduler_timeout": scheduler_timeout}
     if out is None:
         return _sweep(base, grid, None, **options)
-    # One process at a time in the folder: a second sweep (or --overwrite) must not touch a sweep still going.
-    with locked_folder(Path(out)):
+    # One process at a time in the folder, whatever it runs: a second sweep (or --overwrite) must not touch a
+    # sweep still going, nor a run write its result.nc there; and a sweep keeps to a sweep's folders.
+    with locked_folder(Path(out), "sweep"):
         return _sweep(base, grid, Path(out), **options)
 
 
@@ -455,6 +468,7 @@ def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None
         "sweep": json.dumps(grid),
         "configs": json.dumps([json.loads(r.attrs["config"]) for r in results]),
         "slidernet_version": __version__,
+        "slidernet_code": code_digest(),
         "seed": str(seed),
         "kernel": ", ".join(dict.fromkeys(kernels)),
         "Conventions": "CF-1.8",
@@ -489,12 +503,12 @@ _SWEEP_JSON = "sweep.json"
 
 def _identity(base: dict[str, Any], grid: dict[str, list[Any]]) -> dict[str, Any]:
     """What a sweep folder must match to be resumed (JSON-normalized: tuples are lists)."""
-    return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": __version__}))
+    return json.loads(json.dumps({"config": base, "sweep": grid, "slidernet_version": __version__,
+                                  "slidernet_code": code_digest()}))
 
 
 def _clear_folder(folder: Path) -> None:
     """Remove what a sweep writes in ``folder`` (``overwrite``): its identity, points and result."""
-    check_output_dir(folder)
     for name in (_SWEEP_JSON, "result.nc"):
         (folder / name).unlink(missing_ok=True)
     shutil.rmtree(folder / "points", ignore_errors=True)
@@ -516,7 +530,8 @@ def _check_folder(folder: Path, identity: dict[str, Any], resume: bool) -> int |
     stored = read_identity_file(path, {"config": dict, "sweep": dict, "slidernet_version": str, "seed": int},
                                 "a sweep")
     for what, name in (("config", "base configuration"), ("sweep", "grid"),
-                       ("slidernet_version", "slidernet version")):
+                       ("slidernet_version", "slidernet version"),
+                       ("slidernet_code", "code of slidernet (the digest of its sources)")):
         if stored.get(what) != identity[what]:
             raise CheckpointError(
                 f"Cannot resume: the {name} differs from that of the sweep in {str(folder)!r} "

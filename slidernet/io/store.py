@@ -1,14 +1,25 @@
-"""The checkpoint folder of a run: what is done, kept so that a killed run loses (almost) nothing.
+"""Output folders, and a run's checkpoint folder: what is done, kept so that a killed run loses (almost) nothing.
 
-Layout of an output directory ``DIR`` while its run is unfinished (plain
-numeric files and JSON; no pickle)::
+One lock per output folder, whatever writes into it: a run (and its
+resume), a sweep (and each of its points, in its point's folder), the
+paper's reproduction and ``slidernet plot`` (while it makes its picture)
+take the folder's :class:`FolderLock`, ``DIR/.slidernet.lock``, before they
+write anything there, and refuse a folder whose lock another process holds. Each
+kind of output keeps to its own folders: a run never writes into a folder
+that holds a sweep or a paper reproduction, nor they into a run's
+(:func:`check_own_folder`; ``--overwrite`` replaces only the files of its
+own kind).
 
+Layout of a run's output directory ``DIR`` while its run is unfinished
+(plain numeric files and JSON; no pickle)::
+
+    .slidernet.lock          the folder's lock, while a process works in it (FolderLock)
     checkpoint/
-      .slidernet.lock        the run's lock, while a process works on it (FolderLock)
       run.json               the run's identity: the configuration (without its
                              execution table), the resolved seed, the number of
-                             realizations, the slidernet version, the SHA-256 of
-                             every input file (``inputs``), and ``digest``, the
+                             realizations, the slidernet version, the digest of
+                             slidernet's sources (``slidernet_code``), the SHA-256
+                             of every input file (``inputs``), and ``digest``, the
                              SHA-256 of all of these
       block-<first>-<k>.npz  finished realizations, written together: their
                              indices, the run's digest (``run``), then every
@@ -26,7 +37,8 @@ temporary name is removed by the next run in the folder, which holds the lock.
 The set of finished realizations is read from the blocks themselves (not from
 a list that could disagree with them). A block or a partial file is read only
 if it names this run's digest. Once ``result.nc`` is written the checkpoint
-folder is removed.
+folder is removed, and when the run lets its lock go the lock file too: a
+finished run leaves ``DIR/result.nc`` alone.
 """
 
 from __future__ import annotations
@@ -46,6 +58,7 @@ from typing import Any
 
 import numpy as np
 
+from slidernet._paths import not_a_folder, not_utf8
 from slidernet.errors import CheckpointError, CheckpointWarning, FolderInUseError, OutputError
 from slidernet.io.checkpoint import check_arrays, checkpoint_info, read_arrays, write_arrays
 from slidernet.io.netcdf import atomic_output, reason, remove_temporaries
@@ -57,7 +70,13 @@ _BLOCK = re.compile(r"block-(\d+)-(\d+)(?:-(\d+))?\.npz")
 _PARTIAL = re.compile(r"partial-(\d+)\.npz")
 
 #: The keys of a run's identity (``run.json`` holds them and ``digest``).
-IDENTITY_KEYS = ("config", "seed", "realizations", "slidernet_version", "inputs")
+IDENTITY_KEYS = ("config", "seed", "realizations", "slidernet_version", "slidernet_code", "inputs")
+
+#: What each kind of output writes at the top of its folder, by which a folder is known as its. A
+#: sweep's folder holds a result.nc too: the kinds are tried in this order.
+OUTPUT_KINDS: dict[str, tuple[str, ...]] = {"sweep": ("sweep.json", "points"),
+                                            "paper reproduction": ("summary.json", "runs"),
+                                            "run": ("checkpoint", "result.nc")}
 
 
 def _block_order(path: Path) -> tuple[int, int]:
@@ -106,20 +125,23 @@ def file_digest(path: str | Path) -> str:
 
 
 class FolderLock:
-    """An advisory lock on a folder that a run (its checkpoint folder) or a sweep works in: one process at a time.
+    """An advisory lock on an output folder: one slidernet command at a time works in it.
 
     ``flock`` on the file ``folder/.slidernet.lock``, opened for writing (so
     that NFS, which emulates it with byte-range locks, locks it too). The
     operating system releases the lock when the process that holds it ends,
-    however it ends (kill -9 included), so a lock never outlives its run and
-    never blocks a resume; forked worker processes share it. The file holds
-    the holder's process id, for the message of a process that is refused,
-    and is removed on :meth:`release`.
+    however it ends (kill -9 included), so a lock never outlives its command
+    and never blocks a resume; forked worker processes share it. The file
+    holds the holder's process id and what it is doing, for the message of a
+    process that is refused, and is removed on :meth:`release`.
 
     Parameters
     ----------
     folder : path
         An existing folder.
+    holder : str
+        What takes the lock, for that message: ``"run"``, ``"sweep"``,
+        ``"paper reproduction"``, ``"plot"``.
 
     Raises
     ------
@@ -129,8 +151,9 @@ class FolderLock:
 
     NAME = ".slidernet.lock"
 
-    def __init__(self, folder: str | Path) -> None:
+    def __init__(self, folder: str | Path, holder: str) -> None:
         self.folder = Path(folder)
+        self.holder = holder
         self.path = self.folder / self.NAME
         self._fd: int | None = None
 
@@ -157,13 +180,13 @@ class FolderLock:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                holder = _read_pid(fd)
+                pid, what = _read_holder(fd)
                 os.close(fd)
-                who = f"process {holder}" if holder else "another process"
+                who = f"process {pid}" if pid else "another process"
                 raise FolderInUseError(
-                    f"{str(self.folder)!r} is in use: a slidernet run is still going there ({who} holds its lock "
-                    f"{str(self.path)!r}). Wait for it to end, or stop it, before you resume it or start another "
-                    "run there.") from None
+                    f"{str(self.folder)!r} is in use: a slidernet {what} is still going there ({who} holds its "
+                    f"lock {str(self.path)!r}). Wait for it to end, or stop it, before you resume it or start "
+                    "another command there.") from None
             except OSError as exc:
                 os.close(fd)
                 if exc.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EBADF, errno.EINVAL):
@@ -182,7 +205,7 @@ class FolderLock:
                 break
             os.close(fd)
         os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
+        os.write(fd, f"{os.getpid()} {self.holder}\n".encode())
         self._fd = fd
 
     def release(self) -> None:
@@ -202,17 +225,20 @@ class FolderLock:
 
 
 @contextmanager
-def locked_folder(folder: str | Path) -> Iterator[Path]:
-    """Hold ``folder``'s :class:`FolderLock` for the block; the folder is made if missing.
+def locked_folder(folder: str | Path, kind: str) -> Iterator[Path]:
+    """Hold ``folder``'s :class:`FolderLock` for the block, as ``kind`` of :data:`OUTPUT_KINDS`; made if missing.
 
-    Under the lock, what killed processes left there under a temporary name
-    is removed first. A folder made here and left empty by the block is
-    removed again (a run refused before any work leaves no folder behind).
+    Under the lock, a folder that holds another kind of output is refused
+    (:func:`check_own_folder`) and what killed processes left there under a
+    temporary name is removed. A folder made here and left empty by the
+    block is removed again (a command refused before any work leaves no
+    folder behind).
 
     Raises
     ------
     OutputError
-        If ``folder`` is a file or cannot be made.
+        If ``folder`` is not a folder (:func:`check_output_dir`), cannot be
+        made, or holds another kind of output.
     FolderInUseError
         If another process holds the lock.
     """
@@ -224,7 +250,8 @@ def locked_folder(folder: str | Path) -> Iterator[Path]:
     except OSError as exc:
         raise OutputError(f"Cannot create the output directory {str(folder)!r}: {reason(exc)}.") from None
     try:
-        with FolderLock(folder):
+        with FolderLock(folder, kind):
+            check_own_folder(folder, kind)
             remove_temporaries(folder)
             yield folder
     finally:
@@ -232,11 +259,35 @@ def locked_folder(folder: str | Path) -> Iterator[Path]:
             folder.rmdir()
 
 
-def _read_pid(fd: int) -> int | None:
+def check_own_folder(folder: Path, kind: str) -> None:
+    """Refuse to write ``kind`` of output (:data:`OUTPUT_KINDS`) into a folder that holds another kind.
+
+    Whatever the flags: ``--overwrite`` replaces what a command of the same
+    kind wrote there (a run's result, a sweep's points), never another
+    kind's work, which a mistyped ``--out`` would otherwise cost.
+
+    Raises
+    ------
+    OutputError
+        Naming the kind found and the files that tell it.
+    """
+    for held, marks in OUTPUT_KINDS.items():
+        found = [mark for mark in marks if os.path.lexists(folder / mark)]
+        if found:
+            if held != kind:
+                raise OutputError(
+                    f"{str(folder)!r} holds a {held} ({', '.join(found)}): a {kind} does not write there, even "
+                    f"with --overwrite, which replaces only a {kind}'s own files. Use another output directory.")
+            return
+
+
+def _read_holder(fd: int) -> tuple[int | None, str]:
+    """The process id and the kind of command a lock file names (a run, where it does not say)."""
     try:
-        return int(os.pread(fd, 32, 0).decode().strip() or "0") or None
+        pid, _, what = os.pread(fd, 256, 0).decode().strip().partition(" ")
+        return int(pid or "0") or None, what or "run"
     except (OSError, ValueError):
-        return None
+        return None, "command"
 
 
 class RunStore:
@@ -245,11 +296,14 @@ class RunStore:
     Parameters
     ----------
     out_dir : path
-        The run's output directory.
+        The run's output directory; made absolute here (against the current
+        directory), and with it every path of the checkpoint folder that is
+        handed to a worker.
     identity : dict
         ``config`` (the configuration as JSON-ready dict, without ``execution``;
         its ``seed`` as the user gave it), ``seed`` (resolved), ``realizations``,
-        ``slidernet_version`` and ``inputs`` (input file field -> SHA-256).
+        ``slidernet_version``, ``slidernet_code`` (the digest of slidernet's
+        sources) and ``inputs`` (input file field -> SHA-256).
     resume : bool
         Continue the run found there. Without it, a folder that holds an
         interrupted run is refused rather than overwritten.
@@ -259,22 +313,22 @@ class RunStore:
 
     Notes
     -----
-    :meth:`open` takes the folder's lock (:class:`FolderLock`) and
-    :meth:`close` lets it go: call ``close`` however the run ends.
+    :meth:`open` takes the output directory's lock (:class:`FolderLock`,
+    ``out_dir/.slidernet.lock``: the one lock of the folder, whatever works
+    in it) and :meth:`close` lets it go and removes its file: call ``close``
+    however the run ends.
     """
 
     def __init__(self, out_dir: str | Path, identity: dict[str, Any], resume: bool,
                  overwrite: bool = False) -> None:
-        self.dir = Path(out_dir) / "checkpoint"
+        self.dir = Path(out_dir).absolute() / "checkpoint"
         self.identity = dict(identity)
         self.resume = resume
         self.overwrite = overwrite
         self._buffer: dict[int, Record] = {}
         self._created: list[Path] = []  # folders this run made, outermost first (undone by abandon)
         self._wrote_identity = False  # run.json written by this run (undone by abandon)
-        # The lock lives in the checkpoint folder, so that removing the folder at the end of the run
-        # (one rename, remove) also ends the lock: a finished run leaves no lock file behind.
-        self._lock = FolderLock(self.dir)
+        self._lock = FolderLock(self.dir.parent, "run")
 
     @property
     def digest(self) -> str:
@@ -294,44 +348,46 @@ class RunStore:
         Raises
         ------
         OutputError
-            If the output directory is a file or cannot be created, or it
-            holds a finished ``result.nc`` and neither ``overwrite`` nor a
-            run to resume is there.
+            If the output directory is not a folder or cannot be created
+            (:func:`check_output_dir`), holds a sweep or a paper
+            reproduction (:func:`check_own_folder`), or holds a finished
+            ``result.nc`` and neither ``overwrite`` nor a run to resume is
+            there.
         FolderInUseError
-            If a run is still going in the folder (another process holds its lock).
+            If a command is still going in the folder (another process holds its lock).
         CheckpointError
             If it holds an interrupted run and ``resume`` is not set, or
             another run's checkpoint, or nothing to resume; if ``run.json``
-            is damaged; on resume, if the configuration, an input file or
-            the version differ from the run's.
+            is damaged; on resume, if the configuration, an input file, the
+            version or the code differ from the run's.
         """
-        out = self.dir.parent
-        check_output_dir(out)
-        existed = self.dir.is_dir()
-        self._make_dirs(self.dir)
+        check_output_dir(self.dir.parent)
+        self._make_dirs(self.dir.parent)
         try:
             self._lock.acquire()
         except BaseException:
             self.abandon()
             raise
         try:
-            return self._open_locked(existed)
+            return self._open_locked()
         except BaseException:
             self.abandon()
             self.close()
             raise
 
-    def _open_locked(self, existed: bool) -> int:
-        """:meth:`open` under the lock; ``existed``: the checkpoint folder was there before."""
+    def _open_locked(self) -> int:
+        """:meth:`open` under the lock: nothing is written in the folder before its lock is held."""
         out = self.dir.parent
+        check_own_folder(out, "run")
+        existed = self.dir.is_dir()
+        self._make_dirs(self.dir)
         # Under the lock no other process writes here: a temporary file is what a killed one left.
         self.remove_temporaries()
         run_json = self.dir / "run.json"
         result = out / "result.nc"
         if self.overwrite and not self.resume:
-            for path in self.dir.iterdir():  # asked for: whatever run was there is replaced (the lock stays)
-                if path != self._lock.path:
-                    shutil.rmtree(path) if path.is_dir() else path.unlink()
+            for path in self.dir.iterdir():  # asked for: whatever run was there is replaced
+                shutil.rmtree(path) if path.is_dir() else path.unlink()
         if run_json.exists():
             stored = _read_identity(run_json)
             if not self.resume:
@@ -372,7 +428,7 @@ class RunStore:
         return int(self.identity["seed"])
 
     def _check_same_run(self, stored: dict[str, Any]) -> None:
-        """Refuse to resume a run of another configuration, other input files or another version."""
+        """Refuse to resume a run of another configuration, other input files, another version or other code."""
         diff = _flat_diff(stored["config"], self.identity["config"])
         if stored["realizations"] != self.identity["realizations"]:
             diff.append(f"realizations ({stored['realizations']} in the checkpoint, "
@@ -382,11 +438,10 @@ class RunStore:
                 "Cannot resume: the configuration differs from the checkpointed run's in "
                 + "; ".join(diff) + ". Resume with the same configuration, or use another output directory."
             )
-        if stored["slidernet_version"] != self.identity["slidernet_version"]:
-            raise CheckpointError(
-                f"Cannot resume: the checkpoint was written by slidernet {stored['slidernet_version']}, "
-                f"this is {self.identity['slidernet_version']}; results would not be bit-identical."
-            )
+        code = changed_code(stored, self.identity)
+        if code:
+            raise CheckpointError(f"Cannot resume: the checkpoint {code}; results would not be bit-identical. "
+                                  "Resume it with the slidernet that started it, or start again with --overwrite.")
         changed = changed_inputs(stored["inputs"], self.identity["inputs"])
         if changed:
             raise CheckpointError(
@@ -425,9 +480,10 @@ class RunStore:
             try:
                 path.mkdir()
             except FileExistsError:
-                if not path.is_dir():
+                what = not_a_folder(path)
+                if what is not None:  # made by another process meanwhile, as something else
                     self.abandon()
-                    raise OutputError(f"The output path {str(path)!r} is a file; name a folder.") from None
+                    raise OutputError(f"The output path {str(path)!r} {what}; name a folder.") from None
             except OSError as exc:
                 self.abandon()
                 raise OutputError(
@@ -461,7 +517,7 @@ class RunStore:
         remove_temporaries(self.dir)
 
     def close(self) -> None:
-        """Let the folder's lock go (however the run ended; :meth:`open` took it)."""
+        """Let the folder's lock go and remove its file (however the run ended; :meth:`open` took it)."""
         self._lock.release()
 
     def _saved_files(self) -> list[Path]:
@@ -607,8 +663,8 @@ def read_identity_file(path: Path, types: Mapping[str, type], what: str) -> dict
 
 def _read_identity(path: Path) -> dict[str, Any]:
     """A run.json, checked: its keys and their types, and its digest (a flipped bit changes it)."""
-    types = {"config": dict, "seed": int, "realizations": int, "slidernet_version": str, "inputs": dict,
-             "digest": str}
+    types = {"config": dict, "seed": int, "realizations": int, "slidernet_version": str, "slidernet_code": str,
+             "inputs": dict, "digest": str}
     stored = read_identity_file(path, types, "a run")
     if run_digest(stored) != stored["digest"]:
         raise CheckpointError(f"The checkpoint {str(path)!r} is damaged: its contents do not match their digest. "
@@ -631,6 +687,28 @@ def changed_inputs(then: Mapping[str, Any], now: Mapping[str, Any]) -> str:
                      f"{sha(now.get(w))} now)" for w in differ)
 
 
+def changed_code(then: Mapping[str, Any], now: Mapping[str, Any]) -> str:
+    """How the slidernet that wrote ``then`` differs from ``now``'s, in words ('' if it does not).
+
+    Both hold ``slidernet_version`` and ``slidernet_code`` (the digest of
+    the package's sources, :func:`slidernet._version.code_digest`): a run's
+    identity, or a result's attributes.
+
+    >>> print(changed_code({"slidernet_version": "0.1.0", "slidernet_code": "9c3b71d0a2e4f5"},
+    ...                    {"slidernet_version": "0.1.0", "slidernet_code": "1f2e88a04bc6d7"}))
+    ... # doctest: +NORMALIZE_WHITESPACE
+    was computed by other code than this (slidernet 0.1.0 both times, but the digest of its sources is
+    9c3b71d0a2e4 there and 1f2e88a04bc6 here: an edited or another install)
+    """
+    if then.get("slidernet_version") != now["slidernet_version"]:
+        return f"was written by slidernet {then.get('slidernet_version')}, this is {now['slidernet_version']}"
+    if then.get("slidernet_code") != now["slidernet_code"]:
+        return (f"was computed by other code than this (slidernet {now['slidernet_version']} both times, but the "
+                f"digest of its sources is {str(then.get('slidernet_code'))[:12]} there and "
+                f"{now['slidernet_code'][:12]} here: an edited or another install)")
+    return ""
+
+
 def _foreign(path: Path) -> CheckpointError:
     return CheckpointError(
         f"The checkpoint {str(path)!r} belongs to another run (another configuration, input file or seed) than "
@@ -644,9 +722,31 @@ def _recompute(path: Path, exc: CheckpointError, what: str) -> None:
 
 
 def check_output_dir(out: Path) -> None:
-    """Refuse an output directory that is an existing file (the one check every output folder shares)."""
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"The output directory {str(out)!r} is a file; name a folder.")
+    """Refuse an output directory that is not a folder, cannot become one, or has a name netCDF cannot take.
+
+    The one check every output folder shares, made before any work: ``out``
+    or one of its parents is a file, a symbolic link to nothing, to a file
+    or in a loop (each named for what it is); its name is not UTF-8 text
+    (the netCDF library names its files in UTF-8: the run would fail when
+    it writes its result, at its end).
+
+    Raises
+    ------
+    OutputError
+        In one line, naming the path and what it is.
+    """
+    for path in (out, *out.parents):
+        what = not_a_folder(path)
+        if what is not None and path == out:
+            raise OutputError(f"The output directory {str(out)!r} {what}; name a folder.")
+        if what is not None:
+            raise OutputError(f"The output directory {str(out)!r} cannot be made: {str(path)!r} {what}.")
+        if path.is_dir():
+            break
+    text = not_utf8(out.absolute())
+    if text is not None:
+        raise OutputError(f"The output directory {str(out)!r} {text}, and netCDF files are named in UTF-8. "
+                          "Rename it, or name another folder.")
 
 
 # -- records <-> flat arrays ---------------------------------------------------

@@ -42,6 +42,8 @@ from numba import njit
 from numba.core import caching
 from numba.core import event as numba_event
 
+from slidernet._version import folder_digest
+
 try:
     from numba.core.cpu import CPUTargetOptions
 
@@ -74,19 +76,14 @@ def kernel_jit(**options) -> Callable:
     return cached_jit(**options)
 
 
-def folder_digest(folder: Path) -> str:
-    """16 hex digits of the SHA-1 of the names and contents of the ``.py`` files in ``folder``."""
-    h = hashlib.sha1()
-    for path in sorted(Path(folder).glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:16]
-
-
 @functools.cache
 def sources_digest() -> str:
-    """A digest of the kernels' sources (every ``.py`` file of this folder), 16 hex digits."""
-    return folder_digest(_KERNELS)
+    """A digest of the kernels' sources (every ``.py`` file of this folder), 16 hex digits.
+
+    The first digits of :func:`slidernet._version.folder_digest` of this
+    folder, the rule behind the run's code identity too.
+    """
+    return folder_digest(_KERNELS)[:16]
 
 
 @functools.cache
@@ -224,5 +221,4 @@ def on_first_compile(notice: Callable[[], None]) -> Iterator[_FirstCompile]:
         yield listener
 
 
-__all__ = ["cache_dir", "cached_jit", "compile_lock", "folder_digest", "kernel_jit", "on_first_compile",
-           "sources_digest"]
+__all__ = ["cache_dir", "cached_jit", "compile_lock", "kernel_jit", "on_first_compile", "sources_digest"]

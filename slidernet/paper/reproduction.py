@@ -54,7 +54,7 @@ from slidernet.ensemble.runner import run_in
 from slidernet.ensemble.sweep import sweep as run_sweep
 from slidernet.errors import CheckpointError, OutputError, RunInterrupted
 from slidernet.io import write_netcdf
-from slidernet.io.store import check_output_dir, reason
+from slidernet.io.store import locked_folder, reason
 from slidernet.solver.compile import compile_kernels, terminal_notice
 
 __all__ = ["FULL", "QUICK", "Preset", "reproduce"]
@@ -543,7 +543,9 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
     Parameters
     ----------
     out_dir : str or Path
-        Output folder (created if missing).
+        Output folder (created if missing). The reproduction holds its lock
+        (``out_dir/.slidernet.lock``) from before it writes anything until
+        it ends, and never works in a folder that holds a run or a sweep.
     quick : bool
         Use the :data:`QUICK` preset (10 s of wall time on an idle 2-core
         machine) instead of :data:`FULL` (102 s; 183 s of CPU).
@@ -565,10 +567,24 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
         ``fig1_aging.nc``, ``fig2_diffusion.png``, ``fig2_diffusion.nc``,
         ``fig3_rearrangements.png``, ``fig3_rearrangements.nc``,
         ``fig4_mueff.png``, ``fig4_mueff.nc`` and ``summary.json``.
+
+    Raises
+    ------
+    OutputError
+        If ``out_dir`` is not a folder, holds a run or a sweep, or holds a
+        reproduction and neither ``resume`` nor ``overwrite`` is set.
+    FolderInUseError
+        If another command works in ``out_dir`` (it holds the folder's lock).
     """
-    start = time.perf_counter()
     p = _preset if _preset is not None else (QUICK if quick else FULL)
-    out = Path(out_dir)
+    with locked_folder(Path(out_dir), "paper reproduction") as out:
+        return _reproduce(out, p, bool(quick) if _preset is None else None, progress, resume, overwrite)
+
+
+def _reproduce(out: Path, p: Preset, quick: bool | None, progress: bool | None, resume: bool,
+               overwrite: bool) -> dict[str, Path]:
+    """:func:`reproduce` with preset ``p`` in ``out``, whose lock the caller holds (``quick`` None: own ``p``)."""
+    start = time.perf_counter()
     runs = _prepare(out, resume, overwrite)
 
     obs12 = ("n", "mu_max", "x_G")
@@ -651,7 +667,7 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
     summary = {
         "paper": PAPER,
         "preset": asdict(p),
-        "quick": bool(quick) if _preset is None else None,
+        "quick": quick,
         "reference_parameters": {"mu_d": MU_D, "mu_s_mean": MU_S_MEAN, "sigma_mu": SIGMA_MU, "Ntilde": NTILDE},
         "wall_time_s": {**wall, "total_s": time.perf_counter() - start},
         "measured_r_mean": {
@@ -672,9 +688,8 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
 
 
 def _prepare(out: Path, resume: bool, overwrite: bool) -> Path:
-    """Check and make the output folder; return the folder of the runs (``out/runs``)."""
+    """Check the output folder (its lock held) and make ``out/runs``; return that folder of the runs."""
     runs = out / "runs"
-    check_output_dir(out)
     finished = (out / "summary.json").exists() and not runs.exists()
     if overwrite and not resume:
         shutil.rmtree(runs, ignore_errors=True)

@@ -16,27 +16,48 @@ Dask worker imports it again, so the file must exist at the same path
 there. A dotted module name is imported with :func:`importlib.import_module`,
 which Python itself caches.
 
+What a plugin computes may come from other files than its own: a module
+beside it (``import helper``), which may import others. :func:`plugin_sources`
+lists the files of every module a plugin brings in from outside the
+environment (its standard library and site-packages, and slidernet itself,
+whose code the run's identity covers as a whole), so that a run's identity
+can hold their digests: those it brought into ``sys.modules`` when it was
+imported, recorded then, and those its source names in an ``import``
+statement (found again even when another import brought them in first),
+each followed through its own imports. What it cannot see: a module it
+imports only once the run has started (inside a function it calls then), a
+data file it reads, and the code of an installed package.
+
 >>> is_file_entry("my_laws.py"), is_file_entry("my_package.laws")
 (True, False)
 """
 
 from __future__ import annotations
 
+import ast
+import functools
 import hashlib
 import importlib
 import importlib.util
+import os
 import re
+import site
 import sys
+import sysconfig
 import traceback
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from types import ModuleType
 
+from slidernet._paths import absolute_path
 from slidernet.errors import ConfigError
 
 #: The prefix of the module names of plugin files: outside the ``slidernet`` package, so that
 #: no file can shadow one of its modules.
 MODULE_PREFIX = "slidernet_plugin_"
+
+#: The modules each plugin's first import brought into ``sys.modules``, by the plugin module's name.
+_BROUGHT_IN: dict[str, tuple[str, ...]] = {}
 
 
 def is_file_entry(entry: str) -> bool:
@@ -61,17 +82,16 @@ def absolute_entry(entry: str, base: str | Path) -> str:
         The entry, absolute if it is a file (``~`` expanded, symbolic links
         kept: the path the user wrote, anchored).
     """
-    if not is_file_entry(entry):
-        return entry
-    path = Path(entry).expanduser()
-    return str(path if path.is_absolute() else (Path(base) / path).absolute())
+    return absolute_path(entry, base) if is_file_entry(entry) else entry
 
 
 def module_name(path: str | Path) -> str:
     """The module name a plugin file is imported under: its stem and a digest of its resolved path.
 
     The digest (SHA-1, not Python's salted ``hash``) makes the name the same
-    in every process and different for two files of the same name.
+    in every process and different for two files of the same name. It is
+    taken of the path's bytes, so a folder whose name is not UTF-8 text
+    works too.
 
     >>> module_name("/home/me/my_laws.py") == module_name("/home/me/../me/my_laws.py")
     True
@@ -80,7 +100,7 @@ def module_name(path: str | Path) -> str:
     """
     resolved = Path(path).expanduser().resolve()
     stem = re.sub(r"\W", "_", resolved.stem)  # a file name may hold '-' or '.', a module name may not
-    digest = hashlib.sha1(str(resolved).encode("utf-8")).hexdigest()[:12]
+    digest = hashlib.sha1(os.fsencode(resolved)).hexdigest()[:12]
     return f"{MODULE_PREFIX}{stem}_{digest}"
 
 
@@ -112,11 +132,21 @@ def import_plugins(entries: Iterable[str], *, field: str = "'plugins' field") ->
 
 
 def import_plugin(entry: str, *, field: str = "'plugins' field") -> ModuleType:
-    """Import one ``plugins`` entry (see :func:`import_plugins`); an entry already imported is not run again."""
+    """Import one ``plugins`` entry (see :func:`import_plugins`); an entry already imported is not run again.
+
+    The modules its first import brings into ``sys.modules`` are recorded
+    for :func:`plugin_sources`; a plugin imported inside another's import
+    has its own record, and is in the other's too.
+    """
     if not isinstance(entry, str) or not entry:
         raise ConfigError(f"The {field}: {entry!r} is not a file path or a module name (a non-empty string).")
-    if is_file_entry(entry):
-        return _import_file(entry, field)
+    before = set(sys.modules)
+    module = _import_file(entry, field) if is_file_entry(entry) else _import_module(entry, field)
+    _BROUGHT_IN.setdefault(module.__name__, tuple(sorted(set(sys.modules) - before - {module.__name__})))
+    return module
+
+
+def _import_module(entry: str, field: str) -> ModuleType:
     if not all(part.isidentifier() for part in entry.split(".")):
         raise ConfigError(
             f"The {field}: cannot import {entry!r}: it is neither the path of a Python file (ending in .py) "
@@ -175,3 +205,87 @@ def _reason(exc: BaseException, source: Path | None = None) -> str:
     frame = (own or frames or [None])[-1]
     where = f" (line {frame.lineno} of {Path(frame.filename).name})" if frame is not None else ""
     return f"{type(exc).__name__}: {exc}{where}."
+
+
+def plugin_sources(entry: str) -> tuple[str | None, dict[str, str]]:
+    """The files a plugin entry computes with: its own, and those of the modules it brings in from outside.
+
+    Parameters
+    ----------
+    entry : str
+        A ``plugins`` entry (imported here if it was not yet).
+
+    Returns
+    -------
+    own : str or None
+        The entry's file: the entry itself for a ``.py`` file; a dotted
+        module's file where it lies outside the environment's standard
+        library and site-packages (a module of the user's, on
+        ``PYTHONPATH``), else None (an installed package).
+    imports : dict of str to str
+        Module name -> file of every other module outside the environment,
+        and outside slidernet, that the entry's import brought in or that
+        its source imports, followed through their own imports (see the
+        module's docstring), by module name.
+    """
+    module = import_plugin(entry)
+    found: dict[str, str] = {}
+    todo = [module, *(sys.modules[name] for name in _BROUGHT_IN.get(module.__name__, ()) if name in sys.modules)]
+    seen = set()
+    while todo:
+        current = todo.pop()
+        if current.__name__ in seen:
+            continue
+        seen.add(current.__name__)
+        file = _outside_file(current)
+        if file is None and current is not module:
+            continue  # an installed or built-in module: its imports are the environment's
+        if file is not None:
+            found[current.__name__] = file
+        todo += [sys.modules[name] for name in _imported_names(current) if name in sys.modules]
+    own = found.pop(module.__name__, None)
+    return (entry if is_file_entry(entry) else own), dict(sorted(found.items()))
+
+
+@functools.cache
+def _environment() -> tuple[Path, ...]:
+    """The folders whose modules are the environment's: its standard library, site-packages, slidernet."""
+    paths = sysconfig.get_paths()
+    folders = [paths[key] for key in ("stdlib", "platstdlib", "purelib", "platlib") if key in paths]
+    folders += site.getsitepackages() if hasattr(site, "getsitepackages") else []
+    folders += [site.getusersitepackages()] if site.ENABLE_USER_SITE else []
+    folders.append(str(Path(__file__).resolve().parent.parent))  # slidernet: its code digest covers it
+    return tuple(Path(folder).resolve() for folder in folders)
+
+
+def _outside_file(module: ModuleType) -> str | None:
+    """The file of ``module`` if it lies outside :func:`_environment`, else None (none, or the environment's)."""
+    file = getattr(module, "__file__", None)
+    if not isinstance(file, str) or not os.path.isfile(file):
+        return None
+    resolved = Path(file).resolve()
+    return None if any(resolved.is_relative_to(folder) for folder in _environment()) else file
+
+
+def _imported_names(module: ModuleType) -> Iterator[str]:
+    """Every module name an ``import`` statement of ``module``'s source may bring in (and their packages)."""
+    file = getattr(module, "__file__", None)
+    try:
+        tree = ast.parse(Path(file).read_bytes()) if isinstance(file, str) and file.endswith(".py") else None
+    except (OSError, SyntaxError, ValueError):
+        tree = None
+    for node in ast.walk(tree) if tree is not None else ():
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            try:
+                base = importlib.util.resolve_name("." * node.level + (node.module or ""), module.__package__) \
+                    if node.level else node.module
+            except (ImportError, ValueError):  # a relative import outside a package
+                continue
+            names = [f"{base}.{alias.name}" for alias in node.names] + ([base] if base else [])
+        else:
+            continue
+        for name in names:
+            parts = name.split(".")
+            yield from (".".join(parts[:k]) for k in range(1, len(parts) + 1))
