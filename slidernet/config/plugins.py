@@ -17,7 +17,7 @@ from typing import Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict
 from slidernet.errors import ConfigError
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
@@ -51,11 +51,11 @@ class StrengtheningConfig(_Strict):
 
     law: Literal["log", "power"] = Field(
         "log", description="'log': beta ln(1 + a/tau_c); 'power': beta ((1 + a/tau_c)^exponent - 1).")
-    beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    beta: Annotated[FiniteFloat, Field(ge=0)] = Field(
         description="beta >= 0: the strengthening's amplitude, in units of mu_s (0: the option has no effect).")
-    tau_c: Annotated[float, Field(gt=0, allow_inf_nan=False)] = Field(
+    tau_c: PositiveFloat = Field(
         description="tau_c > 0: the age at which strengthening sets in, in tau_th.")
-    exponent: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] | None = Field(
+    exponent: Annotated[FiniteFloat, Field(gt=0, le=1)] | None = Field(
         None, description="The power law's exponent p in (0, 1] (law = 'power' only).")
 
     @model_validator(mode="after")
@@ -88,7 +88,7 @@ class FrictionConfig(_Strict):
     static: PluginSpec = Field(
         description="The distribution p(mu_s) of the static thresholds: a registered name and its "
                     "parameters; conditioned on mu_s > mu_d.")
-    overshoot: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = Field(
+    overshoot: Annotated[FiniteFloat, Field(ge=0, le=1)] | None = Field(
         None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's "
                           "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).")
     strengthening: StrengtheningConfig | None = Field(

@@ -13,7 +13,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from slidernet.config.base import Integer, _Strict
+from slidernet.config.base import Integer, Seed, _Strict
 from slidernet.config.creep import CreepConfig
 from slidernet.config.execution import ExecutionConfig
 from slidernet.config.network import NetworkConfig
@@ -61,7 +61,7 @@ class Config(_Strict):
     # stored results and interrupted runs (run.json) still match it.
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
 
-    seed: Annotated[Integer, Field(ge=0)] | None = Field(
+    seed: Seed | None = Field(
         None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
                           "(None: fresh OS entropy, stored in the result).")
     realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.")

@@ -15,7 +15,7 @@ from typing import Annotated
 
 from pydantic import Field
 
-from slidernet.config.base import _Strict
+from slidernet.config.base import FiniteFloat, Integer, _Strict
 
 
 class TiltConfig(_Strict):
@@ -33,9 +33,9 @@ class TiltConfig(_Strict):
     sliders (``mu_eff_at = "rearrangements"``).
     """
 
-    min_slips: Annotated[int, Field(ge=1)] = Field(
+    min_slips: Annotated[Integer, Field(ge=1)] = Field(
         1, description="Slips of every node within the sliding avalanche (1: the rule of every earlier result).")
-    min_displacement: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    min_displacement: Annotated[FiniteFloat, Field(ge=0)] = Field(
         0.0, description="Displacement of the centre of mass along +x within the sliding avalanche, in mean "
                          "slip lengths of a node (0: none asked).")
 
