@@ -150,6 +150,7 @@ class Config(_Strict):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         size = self.network.size()
         if self.friction.strengthening is not None:
+            self.friction.strengthening.check_growth(self.steps)
             if self.mu_eff_at == "rearrangements":
                 raise ValueError("'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every "
                                  "rearrangement) is made on thresholds that do not age; with "
