@@ -128,8 +128,10 @@ def test_every_integer_field_refuses_what_int64_cannot_hold(model, name, kind, c
 
 # The cases of the issue, through load_config: one line naming the field. (id, dotted key, value, pattern)
 LOOSE = [
-    ("overshoot-text", "friction.overshoot", "0.5", r"'friction\.overshoot' field must be a real number\. Got '0\.5'"),
-    ("overshoot-true", "friction.overshoot", True, r"'friction\.overshoot' field must be a real number\. Got True"),
+    ("overshoot-text", "friction.overshoot", "0.5",
+     r"'friction\.overshoot' field must be a real number\. Got '0\.5'"),
+    ("overshoot-true", "friction.overshoot", True,
+     r"'friction\.overshoot' field must be a real number\. Got True"),
     ("beta-text", "friction.strengthening", {"beta": "0.01", "tau_c": 1.0},
      r"'friction\.strengthening\.beta' field must be a real number\. Got '0\.01'"),
     ("tau_c-true", "friction.strengthening", {"beta": 0.01, "tau_c": True},
