@@ -414,4 +414,8 @@ def build(kind: str, params: Mapping[str, Any], Ntilde: float,
         if rng is None:
             raise ConfigError("An 'irregular' network needs a random generator (rng) for its positions.")
         return irregular(own["n"], Ntilde, rng, **overrides)
-    return from_graph(read_graph(own["path"], positions=own.get("positions")), Ntilde, **overrides)
+    G = read_graph(own["path"], positions=own.get("positions"))
+    try:
+        return from_graph(G, Ntilde, **overrides)
+    except ConfigError as exc:  # what the network makes of the file's values: the file is named
+        raise ConfigError(f"The network file {str(own['path'])!r}: {exc}") from None

@@ -326,7 +326,7 @@ def check_precision(cfg: Config, scene: Scene, found: Scales | None = None) -> N
     terms = float(s.load.max(initial=0.0)) * s.theta + s.f_ext + s.mu_s * float(s.normal_load.max())
     rounding = np.finfo(np.float64).eps * terms
     gap = s.gap * float(s.normal_load.min())
-    if rounding <= PRECISION_SHARE * gap:
+    if rounding <= PRECISION_SHARE * gap:  # False for a NaN on either side: refused as the worst case
         return
     raise PrecisionError(
         f"float64 cannot resolve this run's slips: its forces are sums of terms up to {terms:.3g} N, rounded to "
@@ -356,7 +356,8 @@ def precision_cause(cfg: Config, s: Scales) -> str:
             0.1 / s.gap if s.gap > 0 else math.inf,
         f"'network.f_ext' or 'network.incline' (loads up to {s.f_ext:.3g} N)": s.f_ext,
     }
-    return max(candidates, key=candidates.__getitem__)
+    # NaN (a thermal load or a law's median that is not a number) is the worst case, not the one max() skips.
+    return max(candidates, key=lambda c: math.inf if math.isnan(candidates[c]) else candidates[c])
 
 
 # ---------------------------------------------------------------------------

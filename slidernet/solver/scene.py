@@ -51,14 +51,24 @@ def _operators(net: Network) -> tuple[str, Chain | Plane]:
     node with g_i = 0 is never driven directly (it stays out of the driving
     heaps).
     """
-    g = net.thermal_load()
+    # Every part is checked finite before it is used (a NaN or inf g was zeroed by the rule above, and ran a
+    # network that never moved): an overflow is judged by the part it struck, without numpy's warnings.
+    with np.errstate(over="ignore", invalid="ignore"):
+        if net.dim == 1:
+            K = net.stiffness_matrix()
+            _check_finite("K", K.data)
+        else:
+            indptr, indices, K_id, K_table = net.stiffness_table()
+            _check_finite("K", K_table)
+        g = net.thermal_load()
+        _check_finite("g", g)
+        _check_finite("w", net.normal_load.sum())
     gmax = np.abs(g).max() if g.size else 0.0
     g = np.where(np.abs(g) > 1e-12 * gmax, g, 0.0)
     normal_load = net.normal_load.astype(np.float64)
     w = net.normal_load / net.normal_load.sum()
     unit_load = bool((net.normal_load == 1.0).all())
     if net.dim == 1:
-        K = net.stiffness_matrix()
         return "csr", Chain(
             indptr=K.indptr.astype(np.int64),
             indices=K.indices.astype(np.int64),
@@ -69,9 +79,43 @@ def _operators(net: Network) -> tuple[str, Chain | Plane]:
             w=w,
             unit_load=unit_load,
         )
-    indptr, indices, K_id, K_table = net.stiffness_table()
     return "vec", _plane(indptr, indices, K_id, K_table, g.reshape(-1, 2).astype(np.float64), normal_load, w,
                          unit_load)
+
+
+#: The parts of a network's operators that overflow float64 in a scene it cannot hold: what each is made of,
+#: and the keys of [network] that make it large (a graph's own values come from its file).
+OPERATOR_PARTS = {
+    "K": ("the stiffness matrix K", "its entries sum k e e^T over a node's springs", ("k",)),
+    "g": ("the thermal load g", "it sums k L kappa over a node's springs", ("k", "kappa")),
+    "w": ("the normal loads", "their sum weighs x_G", ("normal_load",)),
+}
+
+
+class _Overflow(Exception):
+    """A part of a network's operators is not finite; ``part`` is its key in :data:`OPERATOR_PARTS` (turned
+    into the ConfigError of :func:`_overflow_message`, which names the configuration's keys)."""
+
+    def __init__(self, part: str) -> None:
+        super().__init__(part)
+        self.part = part
+
+
+def _check_finite(part: str, values: np.ndarray | float) -> None:
+    if not np.isfinite(values).all():
+        raise _Overflow(part)
+
+
+def _overflow_message(exc: _Overflow, cfg: Config) -> str:
+    """The refusal of an overflow, naming the keys of the configuration that make the part large."""
+    name, made, keys = OPERATOR_PARTS[exc.part]
+    given = [f"'network.{key}'" for key in keys if getattr(cfg.network, key) is not None]
+    if cfg.network.kind == "graph":
+        given.append("the values of 'network.path'")
+    cause = ", ".join(given) if given else "the network's values"
+    return (f"This network's operators overflow float64: {name} holds inf or NaN ({made}), from {cause}. "
+            f"Use smaller values (k enters the physics only as k / Ntilde: a smaller k with a smaller Ntilde "
+            f"is the same scene).")
 
 
 def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: np.ndarray, g: np.ndarray,
@@ -198,7 +242,10 @@ class Scene:
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
-        family, operators = _operators(net)
+        try:
+            family, operators = _operators(net)
+        except _Overflow as exc:
+            raise ConfigError(_overflow_message(exc, cfg)) from None
         catalogue = cfg.needs_catalogue()
         two_slider = net.is_two_slider()
         kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, cfg.needs_node_state())
