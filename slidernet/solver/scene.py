@@ -221,6 +221,14 @@ class Scene:
         return self._K
 
     @property
+    def counts_capped(self) -> bool:
+        """True if the network tilt test asks more than the default sliding rule ([tilt]): its tests that meet
+        the avalanche cap before the rule (rule 4 of :mod:`slidernet.kernels.tilt_net`) are counted in
+        ``tilt_capped``, not sampled. Under the default rule that cap's sample is the rule's own (a part
+        sliding alone above mu_d)."""
+        return self.tilt_at == "records" and (self.tilt_min_slips > 1 or self.tilt_min_shift > 0.0)
+
+    @property
     def do_tilt(self) -> bool:
         """True if the kernel makes the appendix's tilt test before every rearrangement."""
         return self.tilt_at == "rearrangements"
@@ -262,6 +270,8 @@ class Scene:
         slide_away = mean_load(net) > cfg.friction.mu_d
         tilt = cfg.tilt_settings()
         min_shift = 0.0
+        if tilt_at == "records":
+            check_tilt_rule(tilt.min_slips, tilt.min_displacement, net.normal_load, cfg.solver.max_avalanche)
         if tilt.min_displacement > 0.0:
             # In mean slip lengths of one slider held by one spring (the creep observables' reference slip),
             # given to the kernel in its lengths, Ntilde l0.
@@ -356,3 +366,41 @@ def tilt_avalanche_cap(n_nodes: int) -> int:
     """Slips of one tilt-test avalanche after which a part of the network slides alone (rule 4 of
     :mod:`slidernet.kernels.tilt_net`): 100 slips per node, and at least 1e5."""
     return max(100 * n_nodes, 100_000)
+
+
+def check_tilt_rule(min_slips: int, min_displacement: float, normal_load: np.ndarray, max_avalanche: int) -> None:
+    """Refuse a sliding rule ([tilt]) that the network tilt test's caps cannot let it meet, naming both numbers.
+
+    The rule is met within one avalanche, which ends at :func:`tilt_avalanche_cap` slips (rule 4) and
+    whose test ends at ``solver.max_avalanche`` slips in all. ``min_slips = m`` needs at least
+    N (m - 1) + 1 slips (every node slipped m times, or m - 1 and about to slip again);
+    ``min_displacement = X`` about X / max_i w_i (X N with equal normal loads): a slip of node i moves
+    the centre of mass by about w_i mean slip lengths, w_i = N_i / sum N. A rule nearer a cap is left
+    to the run, which counts the tests that met the cap first (``tilt_capped``).
+
+    >>> check_tilt_rule(3, 0.0, np.ones(6), 10**8)
+    >>> check_tilt_rule(20_000, 0.0, np.ones(6), 10**8)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The [tilt] table asks each of the 6 sliders to slip min_slips = 20000 ...
+    """
+    n_nodes = int(normal_load.size)
+    cap = tilt_avalanche_cap(n_nodes)
+    caps = sorted([(cap, f"the {cap} slips after which the network tilt test takes a part of the network to "
+                         f"slide on its own (max(100 N, 1e5))"),
+                   (max_avalanche, f"solver.max_avalanche = {max_avalanche}, the slips of a whole test")])
+    limit, what = caps[0]
+    needed = n_nodes * (min_slips - 1) + 1
+    if needed > limit:
+        raise ConfigError(
+            f"The [tilt] table asks each of the {n_nodes} sliders to slip min_slips = {min_slips} times in one "
+            f"avalanche: at least {n_nodes} x {min_slips - 1} + 1 = {needed} slips, more than {what}. Ask fewer."
+        )
+    share = float(normal_load.max() / normal_load.sum())
+    estimate = min_displacement / share
+    if estimate > limit:
+        raise ConfigError(
+            f"The [tilt] table asks the centre of mass to move by min_displacement = {min_displacement:g} mean "
+            f"slip lengths in one avalanche: about {estimate:.3g} slips (a slip of a slider moves it by about "
+            f"its share N_i / sum N <= {share:.3g} of a slip length), more than {what}. Ask less."
+        )
