@@ -32,7 +32,8 @@ class ExecutionConfig(_Strict):
     workers: Annotated[Integer, Field(ge=1)] | None = Field(
         None, description="Local processes that run the realizations (None: every core this process may use).")
     scheduler: str | None = Field(
-        None, description="Address of a Dask scheduler, 'tcp://host:port'; when given, the realizations run "
+        None, description="Address of a Dask scheduler, 'tcp://host:port' (any address a Dask Client can reach "
+                          "a remote scheduler at: scheduler_address_problem); when given, the realizations run "
                           "on that cluster and 'workers' is ignored.")
     checkpoint_every: PositiveReal = Field(
         60.0, description="Seconds between two saves of the work of a run that has an output directory.")

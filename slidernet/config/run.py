@@ -62,8 +62,8 @@ class Config(_Strict):
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
 
     seed: Seed | None = Field(
-        None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
-                          "(None: fresh OS entropy, stored in the result).")
+        None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
+                          "SeedSequence(seed) (None: fresh OS entropy, stored in the result).")
     realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
     steps: Annotated[Integer, Field(ge=1)] = Field(
         description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")

@@ -30,7 +30,10 @@ class TiltConfig(_Strict):
     ``friction.overshoot``), that is by about X slips per node in the
     direction of the tilt; 0, the default, asks for no displacement. Both
     apply to the network tilt test only, not to the appendix's test of two
-    sliders (``mu_eff_at = "rearrangements"``).
+    sliders (``mu_eff_at = "rearrangements"``). A rule that the test's caps
+    (max(100 N, 1e5) slips in one avalanche, ``solver.max_avalanche`` in a
+    test) cannot let it meet is refused before the run; a test that meets
+    the avalanche cap first is counted in ``tilt_capped``, not sampled.
     """
 
     min_slips: Annotated[Integer, Field(ge=1)] = Field(
