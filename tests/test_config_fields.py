@@ -173,7 +173,8 @@ BAD_SCHEDULERS = [
     ("port-zero", "tcp://host:0", r"port"),
     ("port-too-large", "tcp://host:99999", r"port"),
     ("no-host", "tcp://:8786", r"host"),
-    ("inproc", "inproc://x", r"inproc"),
+    ("inproc-malformed", "inproc://x", r"inproc"),
+    ("inproc-another-process", "inproc://127.0.0.1/1/1", r"inproc.*does not match"),
     ("unknown-scheme", "udp://host:8786", r"udp"),
     ("not-an-address", "", r"address"),
 ]
@@ -213,3 +214,27 @@ def test_tls_is_refused_without_the_dask_tls_configuration():
                                      "host.example.org:8786", "ws://host:8786"])
 def test_a_scheduler_address_a_client_accepts_is_accepted(address):
     assert ExecutionConfig(scheduler=address).scheduler == address
+
+
+def test_an_inproc_address_of_this_process_is_accepted():
+    # A LocalCluster(processes=False) started from Python: its scheduler lives in this process.
+    from distributed.comm.inproc import new_address
+
+    address = new_address()
+    assert ExecutionConfig(scheduler=address).scheduler == address
+
+
+def test_a_dask_worker_checks_the_address_alone():
+    # A worker reads the configuration again to run a realization but makes no Client: what depends on the
+    # process that makes one (Dask's TLS settings, here none) is not its to check; the address still is.
+    import distributed
+
+    from slidernet.config.execution import scheduler_address_problem
+
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        in_worker = client.submit(scheduler_address_problem, "tls://host:8786").result()
+        malformed = client.submit(scheduler_address_problem, "tcp://host").result()
+    assert scheduler_address_problem("tls://host:8786") is not None  # here, where a Client would be made
+    assert in_worker is None
+    assert malformed == "missing port number in address 'host'"

@@ -70,7 +70,7 @@ def test_a_test_that_meets_the_cap_first_is_counted_and_left_out_of_mu_eff(monke
     # A cap of 20 slips per avalanche (rule 4) meets the rule of 3 slips per node (at least 13 slips) in most
     # tests before the rule (measured: 37 of 44; a cap of 40 in none): those are counted, not sampled.
     monkeypatch.setattr(realization, "tilt_avalanche_cap", lambda n_nodes: 20)
-    ds = slidernet.run(_config({"min_slips": 3}, realizations=4))
+    ds = slidernet.run(_config({"min_slips": 3}, realizations=4), workers=1)
     capped, count = ds["tilt_capped"].values, ds["mu_eff_count"].values
     assert ds["tilt_capped"].dims == ("t",) and capped.dtype == np.int64
     assert capped.sum() > 0 and count.sum() > 0
@@ -85,14 +85,14 @@ def test_the_default_rule_has_no_count_and_keeps_its_samples(monkeypatch):
     # Rule 4 is part of the default rule (a part sliding alone above mu_d, the rows of a square lattice): its
     # samples are mu_eff's, and the result has no tilt_capped.
     monkeypatch.setattr(realization, "tilt_avalanche_cap", lambda n_nodes: 40)
-    ds = slidernet.run(_config({"min_slips": 1}))
+    ds = slidernet.run(_config({"min_slips": 1}), workers=1)
     assert "tilt_capped" not in ds
     assert int(ds["mu_eff_count"].sum()) == 2 * 11
 
 
 def test_the_count_is_written_and_read_back(tmp_path, monkeypatch):
     monkeypatch.setattr(realization, "tilt_avalanche_cap", lambda n_nodes: 20)
-    ds = slidernet.run(_config({"min_slips": 3}), out=tmp_path / "out")
+    ds = slidernet.run(_config({"min_slips": 3}), out=tmp_path / "out", workers=1)
     back = read_result(tmp_path / "out" / "result.nc")
     assert ds["tilt_capped"].values.sum() > 0
     np.testing.assert_array_equal(back["tilt_capped"].values, ds["tilt_capped"].values)

@@ -59,11 +59,14 @@ def scheduler_address_problem(value: object) -> str | None:
     The address is read as distributed reads it (``distributed.comm.addressing``: ``parse_address``, then
     ``parse_host_port``; no scheme means tcp, as ``Client("host:8786")``), and refused where a Client
     would refuse it before connecting (a bracket left open, a port that is not a number) or could never
-    connect: no host, a host with a space, a port outside 1-65535, ``inproc://`` (a scheduler inside this
-    very process, which a run never starts), a protocol this installation of distributed cannot connect
-    over (``ucx://`` without the package distributed-ucxx), ``tls://`` without Dask's TLS settings, or an
-    unencrypted protocol where Dask's configuration requires encryption. Whether a scheduler answers there
-    is known only by asking it (``execution.scheduler_timeout``).
+    connect: no host, a host with a space, a port outside 1-65535, an ``inproc://`` address that is not
+    one of this very process (a ``LocalCluster(processes=False)`` started from Python has one), a
+    protocol this installation of distributed cannot connect over (``ucx://`` without the package
+    distributed-ucxx), ``tls://`` without Dask's TLS settings, or an unencrypted protocol where Dask's
+    configuration requires encryption. These last depend on the process that makes the Client: a Dask
+    worker, which reads the configuration again to run a realization but makes no Client, checks the
+    address alone. Whether a scheduler answers is known only by asking it
+    (``execution.scheduler_timeout``).
 
     >>> scheduler_address_problem("tcp://10.0.0.1:8786") is None
     True
@@ -80,16 +83,21 @@ def scheduler_address_problem(value: object) -> str | None:
         scheme, location = parse_address(value)
     except ValueError as exc:
         return str(exc)
-    if scheme == "inproc":
-        return ("an inproc:// address names a scheduler inside this very process, which a run never starts; "
-                "a cluster is reached over tcp://, tls://, ws:// or wss://")
     try:
-        connector = registry.get_backend(scheme).get_connector()
+        backend = registry.get_backend(scheme)
     except ValueError:
         return f"distributed knows no protocol {scheme!r} (it knows {', '.join(sorted(registry.backends))})"
-    except Exception:  # the backend's own failure: distributed 2026 keeps 'ucx' as a stub that cannot connect
-        return (f"this installation of distributed cannot connect over {scheme!r}"
-                + (" (UCX needs the package distributed-ucxx)" if scheme == "ucx" else ""))
+    client_side = not _in_dask_worker()
+    if scheme == "inproc":
+        if not client_side:
+            return None
+        try:
+            backend.get_address_host(location)  # distributed's own check: this host, this process
+        except ValueError as exc:
+            return (f"an inproc:// address reaches only a scheduler inside this very process, as "
+                    f"inproc://<ip>/<pid>/<n> ({str(exc) or 'not of that form'}); a cluster is reached over "
+                    f"tcp://, tls://, ws:// or wss://")
+        return None
     try:
         host, port = parse_host_port(location)
     except ValueError as exc:
@@ -99,8 +107,26 @@ def scheduler_address_problem(value: object) -> str | None:
         return f"{host!r} is not a host name or an IP address"
     if not 1 <= port <= 65535:
         return f"the port {port} is not in 1-65535"
+    if not client_side:
+        return None
+    try:
+        connector = backend.get_connector()
+    except Exception:  # the backend's own failure: distributed 2026 keeps 'ucx' as a stub that cannot connect
+        return (f"this installation of distributed cannot connect over {scheme!r}"
+                + (" (UCX needs the package distributed-ucxx)" if scheme == "ucx" else ""))
     # Only the TCP connectors declare whether they encrypt (and enforce require-encryption): the others pass.
     return _security_problem(scheme, getattr(connector, "encrypted", True))
+
+
+def _in_dask_worker() -> bool:
+    """Whether this code runs in a task of a Dask worker (which makes no Client of its own)."""
+    from distributed import get_worker
+
+    try:
+        get_worker()
+    except ValueError:
+        return False
+    return True
 
 
 def _security_problem(scheme: str, encrypted: bool) -> str | None:
