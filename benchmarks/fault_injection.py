@@ -293,8 +293,8 @@ def fault_shared_folder(folder: Path, config: Path, reference: Path) -> tuple[bo
     notes = []
     for first in ("sweep", "run"):
         out = folder / f"shared_{first}_first"
-        sweep = [sys.executable, "-m", "slidernet", "sweep", str(config), "--set", "driver.sigma_theta=1e-6,1.1e-6", "--out", str(out),
-                 "--workers", "2", "--no-progress"]
+        sweep = [sys.executable, "-m", "slidernet", "sweep", str(config), "--set", "driver.sigma_theta=1e-6,2e-6",
+                 "--out", str(out), "--workers", "2", "--no-progress"]
         run = [sys.executable, "-m", "slidernet", "run", str(config), "--out", str(out), "--workers", "2",
                "--no-progress"]
         a, b = (sweep, run) if first == "sweep" else (run, sweep)

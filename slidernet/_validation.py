@@ -8,7 +8,10 @@ theory and the solver can all check values without importing one another:
 - :func:`check_scalar`: one real parameter (a plugin's, a material value);
 - :func:`check_array`: a real parameter that may be an array (the theory's
   vectorised functions);
-- :func:`checked_output`: what a plugin returns.
+- :func:`checked_output`: what a plugin returns;
+- :func:`read_real`: a number read from a data file (a graph, a series, measured
+  thresholds), refused naming the file and the line or element; :func:`is_number_text`
+  tells a header from a line of numbers.
 
 One rule for every parameter: a real number is an ``int`` or a ``float``
 (any :class:`numbers.Real`, numpy's scalars included), never a ``bool`` and
@@ -28,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from slidernet.errors import PluginError, param_error
+from slidernet.errors import ConfigError, PluginError, param_error
 
 # What a requirement asks of a finite float, or elementwise of a finite float array.
 _TESTS: dict[str, Callable[[Any], Any]] = {
@@ -144,6 +147,69 @@ def check_array(value: ArrayLike, param: str, owner: str, requirement: str = "fi
     if not ok.all():
         raise param_error(param, owner, requirement, float(arr[~ok].flat[0]))
     return arr
+
+
+def is_number_text(text: str) -> bool:
+    """Whether Python's ``float`` reads ``text``: how a reader tells a header's words from a line of numbers
+    that :func:`read_real` refuses (``nan``, ``1_0``), which is no header.
+
+    >>> is_number_text("celsius"), is_number_text("nan"), is_number_text(" 1_0 ")
+    (False, True, True)
+    """
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def read_real(value: object, what: str, where: str) -> float:
+    """A finite real number from a data file's field: its text, or a value its format already typed.
+
+    The one rule of every reader of a data file: the text of a number as Python's
+    ``float`` reads it, without the underscores Python allows in its own literals
+    (``1_0`` in a data file is a typo, not 10), or an int or a float the format
+    typed (GraphML's ``double``); never a boolean, never empty.
+
+    Parameters
+    ----------
+    value : object
+        The field as the file gives it.
+    what : str
+        The field's name, quoted as the message should show it (``"'k'"``).
+    where : str
+        The file and the line (or the element), for the message.
+
+    Raises
+    ------
+    ConfigError
+        ``"{where}: {what} must be a number. Got ... instead."``, or ``must be finite``.
+
+    Examples
+    --------
+    >>> read_real(" 2.5 ", "'k'", "net.csv, line 2")
+    2.5
+    >>> read_real("1_0", "'k'", "net.csv, line 2")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: net.csv, line 2: 'k' must be a number. Got '1_0' instead.
+    >>> read_real("inf", "'k'", "net.csv, line 2")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: net.csv, line 2: 'k' must be finite. Got 'inf' instead.
+    """
+    if isinstance(value, str) and "_" not in value:
+        try:
+            number = float(value)
+        except ValueError:
+            number = None
+    else:
+        number = float(value) if is_real(value) else None
+    if number is None:
+        raise ConfigError(f"{where}: {what} must be a number. Got {value!r} instead.")
+    if not math.isfinite(number):
+        raise ConfigError(f"{where}: {what} must be finite. Got {value!r} instead.")
+    return number
 
 
 def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str, call: str) -> np.ndarray:

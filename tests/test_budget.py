@@ -69,6 +69,10 @@ TOO_LARGE = [
     pytest.param({"steps": 10**15, "record": "all"},
                  r"2 realizations x 1,000,000,000,000,001 recorded times.*'record', 'steps'",
                  id="steps-1e15-record-all"),
+    # Issue 43: solver.batch = 2^40 within int64 ended in a MemoryError traceback (8 TiB of draws).
+    pytest.param({"solver": {"batch": 2**40}},
+                 r"each drawing theta for all of its 100 steps.* and 1,099,511,627,776 draws of mu_s in its "
+                 r"buffer.*'solver\.batch'", id="batch-2^40"),
 ]
 
 
@@ -111,6 +115,16 @@ def test_a_sweep_refuses_a_point_that_cannot_fit_before_any_point_runs(machine: 
                                         r"network of 2,000,000,000 sliders"):
         sweep(config(), {"network.n": [8, 2 * 10**9]}, out=tmp_path / "sweep", workers=1, progress=False)
     assert not (tmp_path / "sweep" / "sweep.json").exists()
+
+
+def test_memory_estimate_counts_the_draw_buffers() -> None:
+    plain = budget.memory_estimate(load_config(config()))
+    batch = budget.memory_estimate(load_config(config(solver={"batch": 2**20})))
+    # The thresholds' buffer; a run with tilt tests holds two more (tilt thresholds, uniforms).
+    assert batch.running - plain.running == budget.DRAW_BYTES * (2**20 - 2**16)
+    tilted = budget.memory_estimate(load_config(config(solver={"batch": 2**20}, observables=["mu_eff"],
+                                                       mu_eff_at="records")))
+    assert tilted.running - batch.running == 2 * budget.DRAW_BYTES * 2**20
 
 
 def test_memory_estimate_streams_records_with_an_output_folder() -> None:

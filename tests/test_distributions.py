@@ -282,9 +282,9 @@ def test_parameters_are_validated(cls, params, match):
 EMPIRICAL_FILES = [
     # (id, file text or None for a missing file, extra params, match)
     ("missing", None, {}, r"'path' parameter of empirical must be an existing file\. Got '.*nope\.txt' instead\."),
-    ("not-a-number", "0.6\n0.7\nabc\n", {}, r"line 3: 'abc' is not a number"),
-    ("nan", "0.6\nnan\n0.7\n", {}, r"line 2: the values must be finite\. Got 'nan'"),
-    ("inf", "mu\n0.6\n0.7\n-inf\n", {}, r"line 4: the values must be finite"),
+    ("not-a-number", "0.6\n0.7\nabc\n", {}, r"line 3: the value must be a number\. Got 'abc' instead\."),
+    ("nan", "0.6\nnan\n0.7\n", {}, r"line 2: the value must be finite\. Got 'nan'"),
+    ("inf", "mu\n0.6\n0.7\n-inf\n", {}, r"line 4: the value must be finite"),
     ("one-value", "# header comment\n0.6\n\n", {}, r"must be a file with at least 2 values \(it has 1\)"),
     ("empty", "", {}, r"at least 2 values \(it has 0\)"),
     ("two-columns", "a,0.6\nb,0.7\n", {}, r"line 1 has 2 fields; give 'column'"),

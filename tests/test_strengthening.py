@@ -232,3 +232,25 @@ def test_a_pair_with_strengthening_measures_mu_eff_at_the_records() -> None:
     resolved = load_config(cfg)
     scene = Scene.from_config(resolved)
     assert (scene.kernel, scene.tilt_at) == ("csr", "records")
+
+
+# Issue 43: tau_c = 5e-324 made a / tau_c overflow to inf: mu_max = inf, exit 0. A law whose growth over the
+# run leaves float64, or passes the bound on every threshold (config.plugins.MU_S_MAX), is refused by name.
+@pytest.mark.parametrize(
+    ("table", "grows"),
+    [({"beta": 0.01, "tau_c": 5e-324}, "inf"),
+     ({"law": "power", "beta": 1.0, "tau_c": 1e-200, "exponent": 1.0}, r"1e\+201"),
+     ({"beta": 1e300, "tau_c": 1.0}, r"2\.4e\+300")],
+    ids=["log-tau_c-5e-324", "power-beyond-1e150", "beta-1e300"])
+def test_a_law_that_overflows_over_the_run_is_refused_by_name(table: dict[str, Any], grows: str) -> None:
+    cfg = make_config(**{"steps": 10, "friction.strengthening": table})
+    with pytest.raises(ConfigError, match=r"'friction\.strengthening' .*over the run's 10 steps .*grows by "
+                                          rf"beta L\(steps / tau_c\) = {grows}.*1e\+150"):
+        load_config(cfg)
+
+
+def test_a_tiny_tau_c_within_float64_runs_with_finite_thresholds() -> None:
+    cfg = _config(NETWORKS["chain"], {"beta": 0.01, "tau_c": 1e-300}, steps=5, realizations=1)
+    ds = slidernet.run(cfg)
+    assert np.isfinite(ds["mu_max"].values).all()
+    assert float(ds["mu_max"].max()) < 0.6 + 0.01 * math.log1p(5 / 1e-300) + 0.1

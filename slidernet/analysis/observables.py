@@ -38,6 +38,9 @@ ATTRS = {
                                  "evolution (since t = 0 for a node that has not slipped)", "units": "tau_th"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
                                         "(NaN: none)", "units": "1"},
+    "tilt_capped": {"long_name": "number of network tilt tests at t, over the realizations, that met the "
+                                "avalanche cap (a part of the network sliding alone) before the sliding rule of "
+                                "[tilt]: left out of mu_eff and mu_eff_count", "units": "1"},
 }
 
 
@@ -230,6 +233,7 @@ class EnsembleStats:
         self._moments: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # name -> (mean, M2)
         self._f: dict[str, np.ndarray] = {}
         self._age_count: np.ndarray | None = None  # (T, bins) int64: the nodes' ages, summed over realizations
+        self._capped: np.ndarray | None = None  # (T,) int64: the tilt tests that met the cap first, summed
 
     def _merge(self, name: str, x: np.ndarray) -> None:
         """Fold the chunk ``x`` (B, ...) into the running (mean, M2) of ``name``."""
@@ -261,6 +265,9 @@ class EnsembleStats:
         for name in ("v_creep", "v_creep_cycle"):
             if name in records[0]:
                 self._merge(name, np.array([[r[name]] for r in records], dtype=np.float64))
+        if "tilt_capped" in records[0]:
+            capped = np.stack([r["tilt_capped"] for r in records]).sum(axis=0)
+            self._capped = capped if self._capped is None else self._capped + capped
         if "mu_eff" in self.observables:
             fsum = np.stack([r["f_sum"] for r in records])
             count = np.stack([r["f_count"] for r in records]).astype(float)
@@ -329,6 +336,8 @@ class EnsembleStats:
                                  {"long_name": "standard error of mu_eff", "units": "1"})
             out["mu_eff_count"] = ("t", total.astype(np.int64),
                                    {"long_name": "number of tilt tests pooled into mu_eff", "units": "1"})
+        if self._capped is not None:
+            out["tilt_capped"] = ("t", self._capped.astype(np.int64), ATTRS["tilt_capped"])
         return out
 
 

@@ -9,7 +9,13 @@ A number in a configuration follows the rule of the plugins' parameters
 ``steps = "200"`` or ``realizations = true`` is refused, by name, not read
 as 200 or 1, as pydantic's lax mode would. A whole number may be written
 as a float without a fractional part (``steps = 1e4``: TOML has no other
-way to write a power of ten).
+way to write a power of ten), and must fit int64, where the kernels and the
+result files hold it (``steps = 1e300`` is refused, not overflowed); a seed
+may take the 128 bits of numpy's SeedSequence. Every numeric field of every
+table is one of the types below (``tests/test_config_fields.py`` walks the
+models to check it): a bound is added as ``Annotated[FiniteFloat, Field(ge=0,
+le=1)]``, never with a bare ``int`` or ``float``, which pydantic reads in its
+lax mode.
 """
 
 from __future__ import annotations
@@ -28,16 +34,37 @@ from pydantic_core import PydanticCustomError
 
 from slidernet._validation import is_integral, is_real
 
-#: The pydantic error types of the two rules below, which loading.py words as "must be an integer" and
-#: "must be a real number".
+#: The pydantic error types of the rules below, which loading.py words as "must be an integer", "must be a
+#: real number", "must be an integer within int64 ..." and "must be an integer in [0, 2^128)".
 NOT_INTEGER = "not_integer"
 NOT_REAL = "not_real"
+NOT_INT64 = "not_int64"
+NOT_SEED = "not_seed"
+
+#: The range of a whole number of the configuration: int64, the type the kernels and the result files hold.
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
+#: A seed's bound: numpy's SeedSequence draws 128 bits of fresh entropy (the seed of a run without one).
+SEED_BOUND = 2**128
 
 
-def _integer(value: Any) -> int:
+def _whole(value: Any) -> int:
     if not is_integral(value):
         raise PydanticCustomError(NOT_INTEGER, "must be an integer")
     return int(value)
+
+
+def _integer(value: Any) -> int:
+    n = _whole(value)
+    if not INT64_MIN <= n <= INT64_MAX:
+        raise PydanticCustomError(NOT_INT64, "must be an integer within int64 (-2^63 to 2^63 - 1)")
+    return n
+
+
+def _seed(value: Any) -> int:
+    n = _whole(value)
+    if n >= SEED_BOUND:  # a negative seed is left to the field's bound ("must be >= 0")
+        raise PydanticCustomError(NOT_SEED, "must be an integer in [0, 2^128)")
+    return n
 
 
 def _real(value: Any) -> float:
@@ -50,8 +77,10 @@ def _real(value: Any) -> float:
 # The rule's validator comes last in each Annotated, so that it runs first and pydantic keeps the bounds
 # inside its float schema (NaN is then "must be a finite number", not "must be > 0").
 
-#: A whole number: an int, or a float with no fractional part; never a bool or a string.
+#: A whole number within int64: an int, or a float with no fractional part; never a bool or a string.
 Integer = Annotated[int, BeforeValidator(_integer)]
+#: A seed of numpy's SeedSequence: a whole number in [0, 2^128).
+Seed = Annotated[int, Field(ge=0), BeforeValidator(_seed)]
 #: A finite real number > 0.
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False), BeforeValidator(_real)]
 #: A finite real number.

@@ -21,7 +21,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from slidernet._paths import absolute_path, not_utf8
-from slidernet.config.base import NOT_INTEGER, NOT_REAL
+from slidernet.config.base import NOT_INT64, NOT_INTEGER, NOT_REAL, NOT_SEED
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
 from slidernet.model.builders import graph_files
@@ -55,7 +55,8 @@ def _describe(err: Mapping[str, Any]) -> str:
         return f"The {loc!r} field must be {bounds[kind]} {limit}. Got {got!r} instead."
     if kind == "finite_number":
         return f"The {loc!r} field must be a finite number. Got {got!r} instead."
-    if kind in (NOT_INTEGER, NOT_REAL):  # the rule of slidernet._validation: never a string or a boolean
+    # The rules of config/base.py: never a string or a boolean (slidernet._validation), int64, a seed's 128 bits.
+    if kind in (NOT_INTEGER, NOT_REAL, NOT_INT64, NOT_SEED):
         return f"The {loc!r} field {err['msg']}. Got {got!r} instead."
     if kind == "value_error":
         msg = str(ctx.get("error", err["msg"]))

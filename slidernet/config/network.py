@@ -14,7 +14,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, Seed, _Strict
 from slidernet.errors import SlidernetError
 from slidernet.model.builders import KIND_DIMS, build
 from slidernet.model.network import Network, pair_tilt_applies
@@ -59,7 +59,7 @@ class NetworkConfig(_Strict):
         None, description="[rows, cols] of a 'square' or 'triangular' lattice (at least 2 sliders).")
     path: str | None = Field(
         None, description="A GraphML or edge-list file of kind 'graph'; relative to the TOML file that names it.")
-    seed: Annotated[Integer, Field(ge=0)] | None = Field(
+    seed: Seed | None = Field(
         None, description="Seed of an 'irregular' network's random points (None: 0); the geometry is the "
                           "same for every realization, whatever the run's seed.")
     k: PositiveFloat | None = Field(

@@ -17,8 +17,9 @@ from typing import Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict
 from slidernet.errors import ConfigError
+from slidernet.kernels.strength import strengthening
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
@@ -51,11 +52,11 @@ class StrengtheningConfig(_Strict):
 
     law: Literal["log", "power"] = Field(
         "log", description="'log': beta ln(1 + a/tau_c); 'power': beta ((1 + a/tau_c)^exponent - 1).")
-    beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    beta: Annotated[FiniteFloat, Field(ge=0)] = Field(
         description="beta >= 0: the strengthening's amplitude, in units of mu_s (0: the option has no effect).")
-    tau_c: Annotated[float, Field(gt=0, allow_inf_nan=False)] = Field(
+    tau_c: PositiveFloat = Field(
         description="tau_c > 0: the age at which strengthening sets in, in tau_th.")
-    exponent: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] | None = Field(
+    exponent: Annotated[FiniteFloat, Field(gt=0, le=1)] | None = Field(
         None, description="The power law's exponent p in (0, 1] (law = 'power' only).")
 
     @model_validator(mode="after")
@@ -69,6 +70,32 @@ class StrengtheningConfig(_Strict):
     def constants(self) -> tuple[float, float, float]:
         """(beta, tau_c, exponent) as the kernels take them; exponent 0.0 stands for the logarithmic law."""
         return float(self.beta), float(self.tau_c), 0.0 if self.law == "log" else float(self.exponent)
+
+    def growth(self, age: float) -> float:
+        """beta L(age / tau_c), what a contact of ``age`` tau_th adds to its threshold: the kernels' law
+        (:func:`slidernet.kernels.strength.strengthening`), inf where float64 overflows.
+
+        >>> StrengtheningConfig(beta=0.01, tau_c=1.0).growth(math.e - 1.0)
+        0.01
+        >>> StrengtheningConfig(beta=0.01, tau_c=5e-324).growth(10.0)
+        inf
+        """
+        try:
+            return float(strengthening.py_func(self.constants(), float(age)))
+        except OverflowError:  # math.expm1 of the power law past float64
+            return math.inf
+
+    def check_growth(self, steps: int) -> None:
+        """Refuse a law whose growth over ``steps`` leaves float64 or passes :data:`MU_S_MAX`, the bound on
+        every threshold (a contact that never slips ages by the whole run)."""
+        grows = self.growth(float(steps))
+        if not grows <= MU_S_MAX:
+            raise ValueError(
+                f"the 'friction.strengthening' table: over the run's {steps} steps a contact's threshold grows by "
+                f"beta L(steps / tau_c) = {grows:.3g} (beta = {self.beta!r}, tau_c = {self.tau_c!r}), beyond "
+                f"{MU_S_MAX:g}, the bound on every threshold that keeps the forces and their squares finite in "
+                f"float64; use a larger tau_c or a smaller beta"
+            )
 
 
 class FrictionConfig(_Strict):
@@ -88,7 +115,7 @@ class FrictionConfig(_Strict):
     static: PluginSpec = Field(
         description="The distribution p(mu_s) of the static thresholds: a registered name and its "
                     "parameters; conditioned on mu_s > mu_d.")
-    overshoot: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = Field(
+    overshoot: Annotated[FiniteFloat, Field(ge=0, le=1)] | None = Field(
         None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's "
                           "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).")
     strengthening: StrengtheningConfig | None = Field(

@@ -13,7 +13,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from slidernet.config.base import Integer, _Strict
+from slidernet.config.base import Integer, Seed, _Strict
 from slidernet.config.creep import CreepConfig
 from slidernet.config.execution import ExecutionConfig
 from slidernet.config.network import NetworkConfig
@@ -61,9 +61,9 @@ class Config(_Strict):
     # stored results and interrupted runs (run.json) still match it.
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
 
-    seed: Annotated[Integer, Field(ge=0)] | None = Field(
-        None, description="Seed of the run: realization r is driven by child r of SeedSequence(seed) "
-                          "(None: fresh OS entropy, stored in the result).")
+    seed: Seed | None = Field(
+        None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
+                          "SeedSequence(seed) (None: fresh OS entropy, stored in the result).")
     realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
     steps: Annotated[Integer, Field(ge=1)] = Field(
         description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")
@@ -150,6 +150,7 @@ class Config(_Strict):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
         size = self.network.size()
         if self.friction.strengthening is not None:
+            self.friction.strengthening.check_growth(self.steps)
             if self.mu_eff_at == "rearrangements":
                 raise ValueError("'mu_eff_at = \"rearrangements\"' (the appendix's tilt test before every "
                                  "rearrangement) is made on thresholds that do not age; with "

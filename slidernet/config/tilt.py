@@ -15,7 +15,7 @@ from typing import Annotated
 
 from pydantic import Field
 
-from slidernet.config.base import _Strict
+from slidernet.config.base import FiniteFloat, Integer, _Strict
 
 
 class TiltConfig(_Strict):
@@ -30,12 +30,15 @@ class TiltConfig(_Strict):
     ``friction.overshoot``), that is by about X slips per node in the
     direction of the tilt; 0, the default, asks for no displacement. Both
     apply to the network tilt test only, not to the appendix's test of two
-    sliders (``mu_eff_at = "rearrangements"``).
+    sliders (``mu_eff_at = "rearrangements"``). A rule that the test's caps
+    (max(100 N, 1e5) slips in one avalanche, ``solver.max_avalanche`` in a
+    test) cannot let it meet is refused before the run; a test that meets
+    the avalanche cap first is counted in ``tilt_capped``, not sampled.
     """
 
-    min_slips: Annotated[int, Field(ge=1)] = Field(
+    min_slips: Annotated[Integer, Field(ge=1)] = Field(
         1, description="Slips of every node within the sliding avalanche (1: the rule of every earlier result).")
-    min_displacement: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    min_displacement: Annotated[FiniteFloat, Field(ge=0)] = Field(
         0.0, description="Displacement of the centre of mass along +x within the sliding avalanche, in mean "
                          "slip lengths of a node (0: none asked).")
 

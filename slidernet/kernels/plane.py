@@ -37,13 +37,34 @@ _STEPS_PER_PERIOD = 4000
 _MAX_PERIODS = 50
 
 
+#: Where B^2 - A C of :func:`critical_thetas` cancels more than 2^20 of itself (B^2 above 2^20 A lim^2:
+#: the force's projection on g above 1024 thresholds, |F| then off lim by up to ~1e-10 of it), its
+#: discriminant is taken from Lagrange's identity instead. Below, the first form is kept: the 2D results,
+#: the golden files among them, follow its bits (a last-bit change of one root reorders the events of a
+#: run and changes it; their scenes stay below ~100 thresholds).
+_CANCELLATION = 2.0**20
+
+
 @kernel_jit()
 def critical_thetas(ax, ay, gx, gy, lim):
-    """Roots (theta_dn, theta_up) of |a + g theta| = lim, in the numerically stable form."""
+    """Roots (theta_dn, theta_up) of |a + g theta| = lim, in the numerically stable form.
+
+    The roots come from q = -B -+ sqrt(B^2 - A C) as q / A and C / q (no cancellation between B and the
+    root), and the discriminant from Lagrange's identity where B^2 - A C would cancel (:data:`_CANCELLATION`):
+    |a + g theta| stays at lim to the rounding of a (eps |a|) whatever |a| / lim is.
+    """
     A = gx * gx + gy * gy
     B = ax * gx + ay * gy
     C = ax * ax + ay * ay - lim * lim
-    disc = B * B - A * C
+    if B * B <= _CANCELLATION * A * (lim * lim):
+        disc = B * B - A * C
+    else:
+        # |a| >> lim: B^2 - A C cancels terms of size |a|^2 |g|^2 down to one of size lim^2 |g|^2, and
+        # loses eps |a|^2 / lim^2 of it (all of it from |a| ~ 1e8 lim on, where theta_c put |F| at 0,
+        # not at lim, and the slip divided by zero). Lagrange's identity gives the same number as
+        # A lim^2 - (a x g)^2, whose terms are of its size.
+        cross = ax * gy - ay * gx
+        disc = A * (lim * lim) - cross * cross
     if disc < 0.0:
         disc = 0.0  # rounding at a tangency
     sq = math.sqrt(disc)
@@ -223,9 +244,11 @@ def straight_slip(Fx, Fy, norm, mag, kxx, kxy, kyy, fd, sf):
     (:func:`slip_displacement`). There e has unit length only to the
     rounding of eq. `critique`'s root, which leaves |F(theta_c)| =
     mu_s N (1 + delta): the slip's length is off by the same relative
-    delta, measured at most 5e-14, 7e-12, 3e-10 and 3e-6 at sigma_theta /
-    Ntilde ~ 1, 10, 1e2 and 1e4 (the last near a tangency of the quadratic;
-    ``python benchmarks/driving_slip_direction.py``). It is kept so, not
+    delta, measured at most 5e-14, 7e-12, 2e-10, 2e-10, 4e-9 and 3e-7 at
+    sigma_theta / Ntilde ~ 1, 10, 1e2, 1e4, 1e6 and 1e8 (``python
+    benchmarks/driving_slip_direction.py``; before the discriminant of
+    :func:`critical_thetas` switched to Lagrange's identity, 3e-6 at 1e4 and
+    a zero force, then a division by zero, from ~1e7 on). It is kept so, not
     divided by the computed |F|: the node's force at the event is itself
     off its threshold by that delta (the root's rounding, which no
     normalization removes), and normalizing would change every 2D result in

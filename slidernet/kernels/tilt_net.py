@@ -46,8 +46,9 @@ On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
    rigid connected network a subset cannot slide for ever (the springs to the
    rest stretch), so this happens along floppy modes: each row of a
    ``square`` lattice (central springs only) slides along x independently.
-   If f + f_bar > mu_d that is sliding, and f + f_bar is the sample; if not,
-   the test gives up (``TILT_TOO_LONG``).
+   If f + f_bar > mu_d that is sliding, and f + f_bar is the sample
+   (``pos[STOP] = STOP_CAP`` says so: under a stricter sliding rule it is the
+   cap's sample, not the rule's); if not, the test gives up (``TILT_TOO_LONG``).
 
 For a 1D pair without ``f_ext`` this performs the appendix's test: the same
 sequence of critical forces, the same draws in the same order, and so the
@@ -77,7 +78,7 @@ P_MU = 0  # read position in the threshold buffer
 P_U = 1  # read position in the uniform buffer
 N_SLIPS = 2  # slips made by the test (out)
 STAGE = 3  # 0: start a test; else where a test that ran out of draws resumes (R_REDRAW, R_CREEP)
-STOP = 4  # why the test gave up (out): STOP_SLIPS, STOP_PART, STOP_SLIP_MOTION; 0 otherwise
+STOP = 4  # why the test gave up (out): STOP_SLIPS, STOP_PART, STOP_SLIP_MOTION; STOP_CAP: a sample of rule 4
 # The test's counters, kept here when it returns for draws so that it can resume where it stood.
 S_NODE = 5  # the node whose threshold is to be redrawn
 S_EP = 6  # the current avalanche (see ``epoch``)
@@ -94,6 +95,8 @@ R_CREEP = 2  # the appendix's creep rule (a 1D pair), which redraws both thresho
 STOP_SLIPS = 1  # settings.max_slips slips in all
 STOP_PART = 2  # an avalanche passed av_cap slips with the load at or below mu_d (rule 4)
 STOP_SLIP_MOTION = 3  # an exactly integrated slip did not come to rest within its step budget
+# How a test that gave a sample ended, where it was not the sliding rule (``pos[STOP]``; 0 for the rule).
+STOP_CAP = 4  # an avalanche passed av_cap slips above mu_d: a part slides alone (rule 4), the rule unmet
 
 # Slots of the float array ``loads`` (shape (N_LOADS,)) the test fills, each a load per unit normal load
 # along x, f + f_bar, like the sample; NaN where the event did not happen before the test ended.
@@ -203,7 +206,9 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         and ``pos[P_U]`` on.
     pos : ndarray of int64, shape (N_POS,)
         Read positions (slots ``P_MU``, ``P_U``), the slip count
-        (``N_SLIPS``), why a test gave up (``STOP``), and the test's stage
+        (``N_SLIPS``), why a test gave up or ended at the cap of rule 4
+        (``STOP``: ``STOP_CAP`` with a sample, 0 with the sliding rule's),
+        and the test's stage
         and counters: set ``pos[STAGE] = 0`` to start a test.
     av_cap : int
         Slips of one avalanche after which a part of the network is taken to
@@ -315,6 +320,7 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             return _give_up(pos, loads, f, STOP_SLIPS)
         if av_slips > av_cap:
             if f + f_bar > settings.mu_d:
+                pos[STOP] = STOP_CAP  # a sample, not of the sliding rule: the caller decides what it is worth
                 return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
             return _give_up(pos, loads, f, STOP_PART)
         # Node i's count goes up by one; until its threshold is redrawn it counts as stable.

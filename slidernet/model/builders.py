@@ -1,4 +1,4 @@
-"""Builders of slider networks: lattices, random Delaunay networks and graph files.
+"""Builders of slider networks: lattices, random Delaunay networks and graphs.
 
 Every builder returns a :class:`slidernet.model.network.Network`. Positions are in
 l0 (the natural spring length of the paper), so that on the lattices every
@@ -12,6 +12,10 @@ passed on to :class:`~slidernet.model.network.Network`: a scalar for every sprin
 (or slider), or an array with one value per spring (shape (E,)) or per slider
 (shape (N,)), in that network's order. ``f_ext``, the constant external force
 on each slider, is a number (along x), a d-vector, or one per slider (N, d).
+
+Network files (GraphML, edge lists) are read and written by
+:mod:`slidernet.model.files` (:func:`read_graph`, :func:`write_graph`, re-exported
+here); :func:`from_graph` builds the network of a graph read from one.
 
 :func:`build` is the entry point of the configuration layer::
 
@@ -28,16 +32,9 @@ the 3 rigid-body modes of the triangular and Delaunay networks.
 
 from __future__ import annotations
 
-import ast
-import csv
-import io
 import math
-import numbers
 from collections.abc import Mapping, Sequence
-from os import PathLike
-from pathlib import Path
 from typing import Any
-from xml.etree.ElementTree import ParseError
 
 import networkx as nx
 import numpy as np
@@ -45,6 +42,7 @@ import scipy.spatial
 
 from slidernet._validation import is_integral
 from slidernet.errors import ConfigError, param_error
+from slidernet.model.files import graph_files, read_graph, write_graph
 from slidernet.model.lattice import Lattice
 from slidernet.model.network import Network, chain
 
@@ -53,6 +51,7 @@ __all__ = [
     "KIND_DIMS",
     "build",
     "from_graph",
+    "graph_files",
     "irregular",
     "read_graph",
     "square",
@@ -84,9 +83,6 @@ KIND_DIMS: dict[str, int | None] = {
 # Per-spring or per-slider values a builder passes on to Network.
 _OVERRIDES: dict[str, str] = {"k": "edge", "kappa": "edge", "rest_length": "edge", "normal_load": "node",
                               "f_ext": "node vector"}
-
-_EDGE_LIST_SUFFIXES = (".edgelist", ".txt", ".csv")
-_GRAPH_SUFFIXES = (".graphml", *_EDGE_LIST_SUFFIXES)
 
 
 # --------------------------------------------------------------------------
@@ -343,387 +339,6 @@ def from_graph(G: nx.Graph, Ntilde: float, **overrides: Any) -> Network:
     return Network.from_networkx(G, Ntilde, **overrides)
 
 
-def _suffix(path: Path, owner: str) -> str:
-    suffix = path.suffix.lower()
-    if suffix not in _GRAPH_SUFFIXES:
-        raise ConfigError(
-            f"{owner} cannot handle {str(path)!r}: unknown extension {path.suffix!r}; "
-            f"expected one of {', '.join(_GRAPH_SUFFIXES)}."
-        )
-    return suffix
-
-
-def _nodes_file(path: Path) -> Path:
-    """The companion node file of an edge list: ``net.edgelist`` -> ``net.nodes.csv``."""
-    return path.with_name(path.stem + ".nodes.csv")
-
-
-def graph_files(path: str | PathLike[str]) -> dict[str, Path]:
-    """The files :func:`read_graph` reads for ``path`` without ``positions`` (as a configuration reads it).
-
-    Returns
-    -------
-    dict of str to Path
-        ``"graph"``: the file itself; ``"nodes"``: an edge list's companion
-        node file (``<stem>.nodes.csv``), where the file is an edge list.
-    """
-    p = Path(path)
-    files = {"graph": p}
-    if p.suffix.lower() != ".graphml":
-        files["nodes"] = _nodes_file(p)
-    return files
-
-
-def read_graph(path: str | PathLike[str], positions: Any = None) -> nx.Graph:
-    """Read a network file into a networkx graph that :func:`from_graph` accepts.
-
-    Formats, chosen by extension:
-
-    ``.graphml``
-        GraphML (networkx.read_graphml). GraphML cannot store tuples, so
-        positions are node attributes ``x`` and ``y`` (in l0; only ``x`` in
-        1D). Optional: ``normal_load`` on nodes; ``k``, ``kappa``,
-        ``rest_length`` on edges. Node ids that are all integers become ints.
-        Nodes keep the file's order; directed graphs are made undirected.
-    ``.edgelist``, ``.txt``
-        One spring per line, ``i j`` (integer node ids) then either nothing,
-        ``key=value`` tokens (``0 1 k=2.0 kappa=0.5``) or a Python dict (the
-        format of networkx.write_edgelist: ``0 1 {'k': 2.0}``); keys among
-        ``k``, ``kappa``, ``rest_length``. ``#`` starts a comment.
-    ``.csv``
-        CSV edge list with a header: ``i,j`` (or ``source,target``), then
-        optional columns ``k``, ``kappa``, ``rest_length``.
-
-    Edge lists carry no positions: they come from ``positions`` or else from
-    the companion file ``<stem>.nodes.csv`` next to the edge list, a CSV with
-    header ``node,x[,y][,normal_load]`` (positions in l0, loads in N). The
-    nodes are numbered in the order of that file (or 0..N-1 for
-    ``positions``); every spring must join listed nodes, at most once.
-    :func:`from_graph` numbers the springs in ``G.edges`` order, which is the
-    file's order when the file lists them sorted by (i, j) with i < j (as
-    :func:`write_graph` does).
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file to read.
-    positions : array_like, shape (N,) or (N, 2), optional
-        Positions in l0 of the nodes in graph order (node id i for an edge
-        list); they replace any positions in the file.
-
-    Returns
-    -------
-    networkx.Graph
-        Nodes with ``pos`` or ``x``/``y`` (and ``normal_load``) attributes,
-        edges with ``k``/``kappa``/``rest_length`` where the file gives them.
-
-    Raises
-    ------
-    ConfigError
-        A missing file, an unknown extension, a malformed line, or no
-        positions for some node.
-
-    Examples
-    --------
-    >>> import tempfile, os
-    >>> d = tempfile.mkdtemp()
-    >>> with open(os.path.join(d, "net.edgelist"), "w") as f:
-    ...     _ = f.write("0 1 k=2.0\\n1 2\\n")
-    >>> G = read_graph(os.path.join(d, "net.edgelist"), positions=[0.0, 1.0, 2.0])
-    >>> from_graph(G, Ntilde=1e-7).k.tolist()
-    [2.0, 1.0]
-    """
-    p = Path(path)
-    suffix = _suffix(p, "read_graph")
-    if p.is_dir():
-        raise ConfigError(f"The network file {str(p)!r} is a folder, not a file.")
-    if not p.is_file():
-        raise ConfigError(f"The network file {str(p)!r} does not exist.")
-    try:
-        return _read_graph(p, suffix, positions)
-    except OSError as exc:  # no permission, ...: the reason in the system's words
-        raise ConfigError(f"The network file {str(exc.filename or p)!r} cannot be read: "
-                          f"{exc.strerror or exc}.") from None
-
-
-def _read_graph(p: Path, suffix: str, positions: Any) -> nx.Graph:
-    """:func:`read_graph` of a file that exists (the reading only)."""
-    if suffix == ".graphml":
-        G = _read_graphml(p)
-        if positions is not None:
-            _set_positions(G, list(G.nodes), positions, p)
-        _require_positions(G, p)
-        return G
-    if positions is not None:
-        pos = _positions_array(positions)
-        G = nx.Graph()
-        G.add_nodes_from((v, {"pos": tuple(row)}) for v, row in enumerate(pos.tolist()))
-    else:
-        nodes = _nodes_file(p)
-        if not nodes.is_file():
-            raise ConfigError(
-                f"The edge list {str(p)!r} has no positions: pass positions, or write them to "
-                f"{str(nodes)!r} (CSV with header node,x[,y][,normal_load])."
-            )
-        G = _read_nodes_csv(nodes)
-    if suffix == ".csv":
-        _read_edges_csv(p, G)
-    else:
-        _read_edges_text(p, G)
-    return G
-
-
-def _read_graphml(p: Path) -> nx.Graph:
-    try:
-        G = nx.read_graphml(p)
-    except (ParseError, nx.NetworkXError, ValueError, KeyError) as err:
-        raise ConfigError(f"Cannot read the GraphML file {str(p)!r}: {err}") from err
-    if G.is_directed() or G.is_multigraph():
-        G = nx.Graph(G)
-    # GraphML ids are strings; integer ids (as networkx writes them) read back as ints.
-    try:
-        mapping = {v: int(v) for v in G.nodes}
-    except (TypeError, ValueError):
-        return G
-    if len(set(mapping.values())) == len(mapping):
-        G = nx.relabel_nodes(G, mapping, copy=True)  # copy keeps the node order
-    return G
-
-
-def _positions_array(positions: Any) -> np.ndarray:
-    try:
-        pos = np.asarray(positions, dtype=float)
-    except (TypeError, ValueError):
-        raise param_error("positions", "read_graph", "an array of shape (N,) or (N, 2)", positions) from None
-    if pos.ndim == 1:
-        pos = pos[:, None]
-    if pos.ndim != 2 or pos.shape[1] not in (1, 2) or pos.shape[0] < 1:
-        raise param_error("positions", "read_graph", "an array of shape (N,) or (N, 2)",
-                          f"an array of shape {np.shape(positions)}")
-    return pos
-
-
-def _set_positions(G: nx.Graph, nodes: list, positions: Any, p: Path) -> None:
-    pos = _positions_array(positions)
-    if pos.shape[0] != len(nodes):
-        raise param_error("positions", "read_graph", f"one position per node of {str(p)!r} ({len(nodes)})",
-                          f"{pos.shape[0]} positions")
-    for v, row in zip(nodes, pos.tolist(), strict=True):
-        G.nodes[v]["pos"] = tuple(row)
-
-
-def _require_positions(G: nx.Graph, p: Path) -> None:
-    """Check that every GraphML node has a numeric position, converting numeric strings."""
-    for v, data in G.nodes(data=True):
-        if isinstance(data.get("pos"), tuple):  # set from the positions argument
-            continue
-        # A GraphML 'pos' can only be a string (GraphML has no tuples): x and y rule.
-        data.pop("pos", None)
-        if "x" not in data:
-            raise ConfigError(
-                f"Node {v!r} of {str(p)!r} has no position: GraphML nodes need 'x' (and 'y') "
-                f"attributes in l0, or pass positions."
-            )
-        for c in ("x", "y"):
-            if c in data and not isinstance(data[c], numbers.Real):
-                try:  # an attribute declared as a string in a hand-written file
-                    data[c] = float(data[c])
-                except (TypeError, ValueError):
-                    raise ConfigError(
-                        f"Node {v!r} of {str(p)!r} has a non-numeric {c!r} attribute {data[c]!r}."
-                    ) from None
-
-
-def _float(text: str, what: str, where: str) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: {what} must be a number. Got {text!r} instead.") from None
-    if not math.isfinite(value):
-        raise ConfigError(f"{where}: {what} must be finite. Got {text!r} instead.")
-    return value
-
-
-def _int(text: str, what: str, where: str) -> int:
-    try:
-        return int(text)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: {what} must be an integer node id. Got {text!r} instead.") from None
-
-
-def _text(path: Path) -> io.StringIO:
-    """A network's text file (edge list, nodes file), read as UTF-8 (a byte-order mark is skipped), as a stream.
-
-    Not the locale's encoding: a file then reads the same on every machine, as the TOML file that names it.
-    """
-    data = path.read_bytes()
-    try:
-        return io.StringIO(data.decode("utf-8-sig"), newline="")
-    except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise ConfigError(f"The network file {str(path)!r} is not UTF-8 text: byte 0x{data[exc.start]:02x} on "
-                          f"line {line} cannot be decoded. Save it as UTF-8.") from None
-
-
-def _read_nodes_csv(path: Path) -> nx.Graph:
-    G = nx.Graph()
-    with _text(path) as f:
-        reader = csv.DictReader(f)
-        columns = [c.strip() for c in (reader.fieldnames or [])]
-        allowed = {"node", "x", "y", "normal_load"}
-        if "node" not in columns or "x" not in columns or not set(columns) <= allowed:
-            raise ConfigError(
-                f"The node file {str(path)!r} needs the header node,x[,y][,normal_load]. Got {columns} instead."
-            )
-        reader.fieldnames = columns
-        for row in reader:
-            where = f"{path}, line {reader.line_num}"
-            v = _int(row["node"], "'node'", where)
-            if v in G:
-                raise ConfigError(f"{where}: node {v} is listed twice.")
-            pos = [_float(row["x"], "'x'", where)]
-            if "y" in columns:
-                pos.append(_float(row["y"], "'y'", where))
-            data: dict[str, Any] = {"pos": tuple(pos)}
-            if row.get("normal_load") not in (None, ""):
-                data["normal_load"] = _float(row["normal_load"], "'normal_load'", where)
-            G.add_node(v, **data)
-    return G
-
-
-def _add_spring(G: nx.Graph, i: int, j: int, data: dict[str, float], where: str) -> None:
-    for v in (i, j):
-        if v not in G:
-            raise ConfigError(f"{where}: node {v} has no position.")
-    if G.has_edge(i, j):
-        raise ConfigError(f"{where}: the spring ({i}, {j}) is listed twice.")
-    G.add_edge(i, j, **data)
-
-
-def _spring_data(items: Mapping[Any, Any], where: str) -> dict[str, float]:
-    data = {}
-    for key, value in items.items():
-        if key not in ("k", "kappa", "rest_length"):
-            raise ConfigError(
-                f"{where}: unknown spring attribute {key!r}; expected 'k', 'kappa' or 'rest_length'."
-            )
-        data[key] = _float(value, repr(key), where)
-    return data
-
-
-def _read_edges_text(path: Path, G: nx.Graph) -> None:
-    with _text(path) as f:
-        for number, raw in enumerate(f, start=1):
-            line = raw.split("#", 1)[0].strip()
-            if not line:
-                continue
-            where = f"{path}, line {number}"
-            tokens = line.split(None, 2)
-            if len(tokens) < 2:
-                raise ConfigError(f"{where}: expected 'i j [key=value ...]'. Got {line!r} instead.")
-            rest = tokens[2] if len(tokens) == 3 else ""
-            if rest.startswith("{"):
-                try:
-                    items = ast.literal_eval(rest)
-                except (ValueError, SyntaxError):
-                    items = None
-                if not isinstance(items, dict):
-                    raise ConfigError(f"{where}: cannot read the spring attributes {rest!r}.")
-            else:
-                items = {}
-                for tok in rest.split():
-                    key, eq, value = tok.partition("=")
-                    if not eq:
-                        raise ConfigError(f"{where}: expected key=value after 'i j'. Got {tok!r} instead.")
-                    items[key] = value
-            i = _int(tokens[0], "i", where)
-            j = _int(tokens[1], "j", where)
-            _add_spring(G, i, j, _spring_data(items, where), where)
-
-
-def _read_edges_csv(path: Path, G: nx.Graph) -> None:
-    with _text(path) as f:
-        reader = csv.DictReader(f)
-        columns = [c.strip() for c in (reader.fieldnames or [])]
-        ends = next((pair for pair in (("i", "j"), ("source", "target")) if set(pair) <= set(columns)), None)
-        if ends is None or not set(columns) - set(ends) <= {"k", "kappa", "rest_length"}:
-            raise ConfigError(
-                f"The edge list {str(path)!r} needs the header i,j (or source,target) "
-                f"[,k][,kappa][,rest_length]. Got {columns} instead."
-            )
-        reader.fieldnames = columns
-        for row in reader:
-            where = f"{path}, line {reader.line_num}"
-            data = {c: v for c, v in row.items() if c not in ends and v not in (None, "")}
-            _add_spring(G, _int(row[ends[0]], ends[0], where), _int(row[ends[1]], ends[1], where),
-                        _spring_data(data, where), where)
-
-
-def write_graph(net: Network, path: str | PathLike[str]) -> list[Path]:
-    """Write a network to a file that :func:`read_graph` reads back exactly.
-
-    ``.graphml`` stores positions as node attributes ``x`` (and ``y``);
-    edge lists (``.edgelist``, ``.txt``: ``i j k=.. kappa=.. rest_length=..``;
-    ``.csv``: header ``i,j,k,kappa,rest_length``) also write the companion
-    ``<stem>.nodes.csv`` (``node,x[,y],normal_load``). Floats are written with
-    ``repr``, so reading back gives the same arrays bit for bit. Node ids are
-    the indices 0..N-1.
-
-    Parameters
-    ----------
-    net : Network
-        The network to write.
-    path : str or path-like
-        Destination; its extension chooses the format.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files written.
-
-    Examples
-    --------
-    >>> import tempfile, os
-    >>> net = square((2, 2), Ntilde=1e-7, k=[1.0, 2.0, 3.0, 4.0])
-    >>> path = os.path.join(tempfile.mkdtemp(), "net.graphml")
-    >>> back = from_graph(read_graph(write_graph(net, path)[0]), Ntilde=1e-7)
-    >>> back.k.tolist(), bool((back.positions == net.positions).all())
-    ([1.0, 2.0, 3.0, 4.0], True)
-    """
-    p = Path(path)
-    suffix = _suffix(p, "write_graph")
-    axes = ("x", "y")[: net.dim]
-    if suffix == ".graphml":
-        G = net.to_networkx()
-        for _, data in G.nodes(data=True):
-            data.update(zip(axes, data.pop("pos"), strict=True))
-            if "f_ext" in data:  # GraphML attributes are scalars
-                data.update(zip(("f_ext_x", "f_ext_y"), data.pop("f_ext"), strict=False))
-        nx.write_graphml(G, p)
-        return [p]
-    if net.f_ext.any():
-        # Refused rather than dropped: the edge-list formats have no column for it.
-        raise ConfigError(f"{str(p)!r}: an edge list cannot store the network's external forces f_ext; "
-                          "write a '.graphml' file instead.")
-    nodes = _nodes_file(p)
-    with nodes.open("w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(["node", *axes, "normal_load"])
-        # tolist() gives Python floats, whose str is the shortest exact repr.
-        for v, (pos, load) in enumerate(zip(net.positions.tolist(), net.normal_load.tolist(), strict=True)):
-            w.writerow([v, *pos, load])
-    cols = zip(net.edges.tolist(), net.k.tolist(), net.kappa.tolist(), net.rest_length.tolist(), strict=True)
-    with p.open("w", newline="", encoding="utf-8") as f:
-        if suffix == ".csv":
-            w = csv.writer(f)
-            w.writerow(["i", "j", "k", "kappa", "rest_length"])
-            w.writerows([i, j, k, kappa, L] for (i, j), k, kappa, L in cols)
-        else:
-            f.write("# i j k=.. kappa=.. rest_length=..  (positions in " + nodes.name + ")\n")
-            f.writelines(f"{i} {j} k={k!r} kappa={kappa!r} rest_length={L!r}\n" for (i, j), k, kappa, L in cols)
-    return [p, nodes]
-
-
 # --------------------------------------------------------------------------
 # Dispatch for the configuration layer
 # --------------------------------------------------------------------------
@@ -799,4 +414,8 @@ def build(kind: str, params: Mapping[str, Any], Ntilde: float,
         if rng is None:
             raise ConfigError("An 'irregular' network needs a random generator (rng) for its positions.")
         return irregular(own["n"], Ntilde, rng, **overrides)
-    return from_graph(read_graph(own["path"], positions=own.get("positions")), Ntilde, **overrides)
+    G = read_graph(own["path"], positions=own.get("positions"))
+    try:
+        return from_graph(G, Ntilde, **overrides)
+    except ConfigError as exc:  # what the network makes of the file's values: the file is named
+        raise ConfigError(f"The network file {str(own['path'])!r}: {exc}") from None

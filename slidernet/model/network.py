@@ -137,8 +137,17 @@ class Network:
                               f"indices from {e.min()} to {e.max()}")
         if (e[:, 0] == e[:, 1]).any():
             raise param_error("edges", owner, "free of self-loops", "a self-loop")
-        dx = x[e[:, 1]] - x[e[:, 0]]
-        length = np.abs(dx[:, 0]) if x.shape[1] == 1 else np.hypot(dx[:, 0], dx[:, 1])
+        with np.errstate(over="ignore"):  # judged just below, by the springs it concerns
+            dx = x[e[:, 1]] - x[e[:, 0]]
+            length = np.abs(dx[:, 0]) if x.shape[1] == 1 else np.hypot(dx[:, 0], dx[:, 1])
+        if not np.isfinite(length).all():
+            # Positions of +-1e308 are finite, their differences not: the unit vectors would be NaN.
+            a, b = e[int(np.argmax(~np.isfinite(length)))]
+            raise ConfigError(
+                f"The sliders {int(a)} and {int(b)}, joined by a spring, lie too far apart, beyond float64: their "
+                f"positions differ by more than {np.finfo(np.float64).max:.3g} l0 (the spring's unit vector would "
+                f"be NaN)."
+            )
         if (length == 0).any():
             raise ConfigError(
                 "Two sliders joined by a spring share one position; springs need length > 0."

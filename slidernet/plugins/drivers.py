@@ -34,7 +34,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from slidernet._validation import check_scalar
+from slidernet._validation import check_scalar, is_number_text, read_real
 from slidernet.errors import ConfigError, param_error
 from slidernet.kernels.jit import cached_jit
 
@@ -324,12 +324,14 @@ def _read_series(path: Path, delimiter: str, owner: str) -> tuple[np.ndarray, np
                 if len(fields) != 2:
                     raise ConfigError(f"{where}: line {lineno} has {len(fields)} columns; expected 2 "
                                       f"(time, temperature) separated by {delimiter!r}.")
+                line = f"{where}: line {lineno}"
                 try:
-                    rows.append((float(fields[0]), float(fields[1])))
-                except ValueError:
-                    if not header_allowed:
-                        raise ConfigError(f"{where}: line {lineno} is not two numbers: "
-                                          f"{delimiter.join(fields)!r}.") from None
+                    rows.append((read_real(fields[0], "'time'", line),
+                                 read_real(fields[1], "'temperature'", line)))
+                except ConfigError:
+                    # A header is the first line that is not two numbers, and only the first.
+                    if not header_allowed or all(is_number_text(f) for f in fields):
+                        raise
                 header_allowed = False
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{where} cannot be read: {exc}") from None
@@ -337,9 +339,6 @@ def _read_series(path: Path, delimiter: str, owner: str) -> tuple[np.ndarray, np
         raise ConfigError(f"{where} has {len(rows)} data row(s); at least 2 are needed.")
     data = np.array(rows, dtype=np.float64)
     time, temperature = data[:, 0], data[:, 1]
-    bad = ~np.isfinite(data).all(axis=1)
-    if bad.any():
-        raise ConfigError(f"{where} has NaN or inf values, first in data row {int(np.argmax(bad)) + 1}.")
     step = np.diff(time)
     if (step <= 0).any():
         i = int(np.argmax(step <= 0))

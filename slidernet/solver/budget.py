@@ -53,6 +53,10 @@ STATE_BYTES = 46.0
 #: Bytes per thermal step of a running realization: theta(t_q), drawn for the whole run at once (8 bytes
 #: a step; the same command).
 THETA_BYTES = 9.0
+#: Bytes per value of a draw buffer (``solver.batch`` values each: the thresholds', and with tilt tests the tilt
+#: thresholds' and uniforms'), measured by the peak resident memory of one realization of a chain of 8 with
+#: solver.batch = 2^22 and 2^25: 8.0 bytes per value and buffer (24.0 with the tilt tests' two more).
+DRAW_BYTES = 8.0
 #: Bytes per realization and recorded time of the records held (n, mu_max, x_G, the tilt sums, the network's
 #: series, and the dataset assembled from them), the same command (record = "all", 2e5 and 2e6 steps).
 RECORD_BYTES = 216.0
@@ -150,19 +154,23 @@ def memory_estimate(cfg: Config, workers: int = 1, *, streamed: bool = False) ->
     running = min(int(workers), R)
     times = recorded_times(cfg)
     held = min(R, STREAMED + running) if streamed else R
+    buffers = 3 if "mu_eff" in cfg.observables else 1
+    batch = cfg.solver.batch
     records_hint = "the records of each realization at each recorded time ('record', 'steps', 'realizations'" + (
         ")" if streamed else "; an output folder, --out, writes them 1024 realizations at a time)")
     return MemoryEstimate(
         network=SCENE_BYTES[cfg.network.kind] * nodes,
-        running=running * (STATE_BYTES * nodes + THETA_BYTES * (cfg.steps + 1)),
+        running=running * (STATE_BYTES * nodes + THETA_BYTES * (cfg.steps + 1) + DRAW_BYTES * buffers * batch),
         records=RECORD_BYTES * held * times,
         ensemble=REALIZATION_BYTES[streamed] * R,
         what={
             "network": f"the network of {nodes:,} sliders, about {SCENE_BYTES[cfg.network.kind]:.0f} bytes each "
                        f"({_size_keys(cfg)})",
             "running": f"the {running} realization(s) running at once, each drawing theta for all of its "
-                       f"{cfg.steps:,} steps, {THETA_BYTES:.0f} bytes a step, and holding {STATE_BYTES:.0f} bytes "
-                       f"a slider ('steps'; fewer workers)",
+                       f"{cfg.steps:,} steps, {THETA_BYTES:.0f} bytes a step, holding {STATE_BYTES:.0f} bytes "
+                       f"a slider and {batch:,} draws of mu_s in its buffer"
+                       + (" and two more of the tilt tests" if buffers > 1 else "")
+                       + " ('steps', 'solver.batch'; fewer workers)",
             "records": f"{held:,} realizations x {times:,} recorded times, about {RECORD_BYTES:.0f} bytes each: "
                        + records_hint,
             "ensemble": f"the bookkeeping of {R:,} realizations, about {REALIZATION_BYTES[streamed]:.0f} bytes "
@@ -318,7 +326,7 @@ def check_precision(cfg: Config, scene: Scene, found: Scales | None = None) -> N
     terms = float(s.load.max(initial=0.0)) * s.theta + s.f_ext + s.mu_s * float(s.normal_load.max())
     rounding = np.finfo(np.float64).eps * terms
     gap = s.gap * float(s.normal_load.min())
-    if rounding <= PRECISION_SHARE * gap:
+    if rounding <= PRECISION_SHARE * gap:  # False for a NaN on either side: refused as the worst case
         return
     raise PrecisionError(
         f"float64 cannot resolve this run's slips: its forces are sums of terms up to {terms:.3g} N, rounded to "
@@ -348,7 +356,8 @@ def precision_cause(cfg: Config, s: Scales) -> str:
             0.1 / s.gap if s.gap > 0 else math.inf,
         f"'network.f_ext' or 'network.incline' (loads up to {s.f_ext:.3g} N)": s.f_ext,
     }
-    return max(candidates, key=candidates.__getitem__)
+    # NaN (a thermal load or a law's median that is not a number) is the worst case, not the one max() skips.
+    return max(candidates, key=lambda c: math.inf if math.isnan(candidates[c]) else candidates[c])
 
 
 # ---------------------------------------------------------------------------

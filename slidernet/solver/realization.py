@@ -102,6 +102,8 @@ class Realization:
             self.out.update(contact_age=np.zeros(T), contact_age_count=np.zeros((T, kernels.N_AGE_BINS), np.int64))
         if scene.tilt_loads:
             self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
+        if scene.counts_capped:
+            self.out["tilt_capped"] = np.zeros(T, np.int64)
         self._tilted = 0  # recorded times whose network tilt test is done
         self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
@@ -289,13 +291,17 @@ class Realization:
         return self.streams.refill(status, self.state)
 
     def _tilt_record(self, k: int) -> None:
-        f = self.tilt_test()
-        self.out["f_sum"][k] += f
-        self.out["f_sq"][k] += f * f
-        self.out["f_count"][k] += 1
-        if self.scene.tilt_loads:
-            from slidernet.kernels.tilt_net import L_FIRST, L_MOVING
+        from slidernet.kernels.tilt_net import L_FIRST, L_MOVING, STOP, STOP_CAP
 
+        f = self.tilt_test()
+        if self.scene.counts_capped and self._tilt_work[3][STOP] == STOP_CAP:
+            # The avalanche cap's sample, not the stricter rule's: counted, never pooled into mu_eff as the rule's.
+            self.out["tilt_capped"][k] += 1
+        else:
+            self.out["f_sum"][k] += f
+            self.out["f_sq"][k] += f * f
+            self.out["f_count"][k] += 1
+        if self.scene.tilt_loads:
             loads = self._tilt_work[4]
             self.out["tilt_first_slip"][k] = loads[L_FIRST]
             self.out["tilt_all_moving"][k] = loads[L_MOVING]
@@ -439,7 +445,9 @@ class Realization:
         dict of str to ndarray
             ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
             (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
-            record bin, shape (T,), and the scalar ``n_events``; where the
+            record bin, shape (T,) (under a stricter sliding rule, ``tilt_capped``:
+            the tests that met the avalanche cap first, which these leave out),
+            and the scalar ``n_events``; where the
             scene can slide away (``scene.records_slide``), the scalar
             ``slid_away_at`` (tau_th; NaN if it did not); the backend's
             own (``backend.result``), and with the observable

@@ -51,14 +51,24 @@ def _operators(net: Network) -> tuple[str, Chain | Plane]:
     node with g_i = 0 is never driven directly (it stays out of the driving
     heaps).
     """
-    g = net.thermal_load()
+    # Every part is checked finite before it is used (a NaN or inf g was zeroed by the rule above, and ran a
+    # network that never moved): an overflow is judged by the part it struck, without numpy's warnings.
+    with np.errstate(over="ignore", invalid="ignore"):
+        if net.dim == 1:
+            K = net.stiffness_matrix()
+            _check_finite("K", K.data)
+        else:
+            indptr, indices, K_id, K_table = net.stiffness_table()
+            _check_finite("K", K_table)
+        g = net.thermal_load()
+        _check_finite("g", g)
+        _check_finite("w", net.normal_load.sum())
     gmax = np.abs(g).max() if g.size else 0.0
     g = np.where(np.abs(g) > 1e-12 * gmax, g, 0.0)
     normal_load = net.normal_load.astype(np.float64)
     w = net.normal_load / net.normal_load.sum()
     unit_load = bool((net.normal_load == 1.0).all())
     if net.dim == 1:
-        K = net.stiffness_matrix()
         return "csr", Chain(
             indptr=K.indptr.astype(np.int64),
             indices=K.indices.astype(np.int64),
@@ -69,9 +79,43 @@ def _operators(net: Network) -> tuple[str, Chain | Plane]:
             w=w,
             unit_load=unit_load,
         )
-    indptr, indices, K_id, K_table = net.stiffness_table()
     return "vec", _plane(indptr, indices, K_id, K_table, g.reshape(-1, 2).astype(np.float64), normal_load, w,
                          unit_load)
+
+
+#: The parts of a network's operators that overflow float64 in a scene it cannot hold: what each is made of,
+#: and the keys of [network] that make it large (a graph's own values come from its file).
+OPERATOR_PARTS = {
+    "K": ("the stiffness matrix K", "its entries sum k e e^T over a node's springs", ("k",)),
+    "g": ("the thermal load g", "it sums k L kappa over a node's springs", ("k", "kappa")),
+    "w": ("the normal loads", "their sum weighs x_G", ("normal_load",)),
+}
+
+
+class _Overflow(Exception):
+    """A part of a network's operators is not finite; ``part`` is its key in :data:`OPERATOR_PARTS` (turned
+    into the ConfigError of :func:`_overflow_message`, which names the configuration's keys)."""
+
+    def __init__(self, part: str) -> None:
+        super().__init__(part)
+        self.part = part
+
+
+def _check_finite(part: str, values: np.ndarray | float) -> None:
+    if not np.isfinite(values).all():
+        raise _Overflow(part)
+
+
+def _overflow_message(exc: _Overflow, cfg: Config) -> str:
+    """The refusal of an overflow, naming the keys of the configuration that make the part large."""
+    name, made, keys = OPERATOR_PARTS[exc.part]
+    given = [f"'network.{key}'" for key in keys if getattr(cfg.network, key) is not None]
+    if cfg.network.kind == "graph":
+        given.append("the values of 'network.path'")
+    cause = ", ".join(given) if given else "the network's values"
+    return (f"This network's operators overflow float64: {name} holds inf or NaN ({made}), from {cause}. "
+            f"Use smaller values (k enters the physics only as k / Ntilde: a smaller k with a smaller Ntilde "
+            f"is the same scene).")
 
 
 def _plane(indptr: np.ndarray, indices: np.ndarray, K_id: np.ndarray, K_table: np.ndarray, g: np.ndarray,
@@ -177,6 +221,14 @@ class Scene:
         return self._K
 
     @property
+    def counts_capped(self) -> bool:
+        """True if the network tilt test asks more than the default sliding rule ([tilt]): its tests that meet
+        the avalanche cap before the rule (rule 4 of :mod:`slidernet.kernels.tilt_net`) are counted in
+        ``tilt_capped``, not sampled. Under the default rule that cap's sample is the rule's own (a part
+        sliding alone above mu_d)."""
+        return self.tilt_at == "records" and (self.tilt_min_slips > 1 or self.tilt_min_shift > 0.0)
+
+    @property
     def do_tilt(self) -> bool:
         """True if the kernel makes the appendix's tilt test before every rearrangement."""
         return self.tilt_at == "rearrangements"
@@ -198,7 +250,10 @@ class Scene:
     def from_config(cls, cfg: Config, network: Network | None = None) -> Scene:
         """Build the scene and pick its kernel (``solver.kernel = "auto"``)."""
         net = build_network(cfg) if network is None else network
-        family, operators = _operators(net)
+        try:
+            family, operators = _operators(net)
+        except _Overflow as exc:
+            raise ConfigError(_overflow_message(exc, cfg)) from None
         catalogue = cfg.needs_catalogue()
         two_slider = net.is_two_slider()
         kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, cfg.needs_node_state())
@@ -215,6 +270,8 @@ class Scene:
         slide_away = mean_load(net) > cfg.friction.mu_d
         tilt = cfg.tilt_settings()
         min_shift = 0.0
+        if tilt_at == "records":
+            check_tilt_rule(tilt.min_slips, tilt.min_displacement, net.normal_load, cfg.solver.max_avalanche)
         if tilt.min_displacement > 0.0:
             # In mean slip lengths of one slider held by one spring (the creep observables' reference slip),
             # given to the kernel in its lengths, Ntilde l0.
@@ -309,3 +366,41 @@ def tilt_avalanche_cap(n_nodes: int) -> int:
     """Slips of one tilt-test avalanche after which a part of the network slides alone (rule 4 of
     :mod:`slidernet.kernels.tilt_net`): 100 slips per node, and at least 1e5."""
     return max(100 * n_nodes, 100_000)
+
+
+def check_tilt_rule(min_slips: int, min_displacement: float, normal_load: np.ndarray, max_avalanche: int) -> None:
+    """Refuse a sliding rule ([tilt]) that the network tilt test's caps cannot let it meet, naming both numbers.
+
+    The rule is met within one avalanche, which ends at :func:`tilt_avalanche_cap` slips (rule 4) and
+    whose test ends at ``solver.max_avalanche`` slips in all. ``min_slips = m`` needs at least
+    N (m - 1) + 1 slips (every node slipped m times, or m - 1 and about to slip again);
+    ``min_displacement = X`` about X / max_i w_i (X N with equal normal loads): a slip of node i moves
+    the centre of mass by about w_i mean slip lengths, w_i = N_i / sum N. A rule nearer a cap is left
+    to the run, which counts the tests that met the cap first (``tilt_capped``).
+
+    >>> check_tilt_rule(3, 0.0, np.ones(6), 10**8)
+    >>> check_tilt_rule(20_000, 0.0, np.ones(6), 10**8)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The [tilt] table asks each of the 6 sliders to slip min_slips = 20000 ...
+    """
+    n_nodes = int(normal_load.size)
+    cap = tilt_avalanche_cap(n_nodes)
+    caps = sorted([(cap, f"the {cap} slips after which the network tilt test takes a part of the network to "
+                         f"slide on its own (max(100 N, 1e5))"),
+                   (max_avalanche, f"solver.max_avalanche = {max_avalanche}, the slips of a whole test")])
+    limit, what = caps[0]
+    needed = n_nodes * (min_slips - 1) + 1
+    if needed > limit:
+        raise ConfigError(
+            f"The [tilt] table asks each of the {n_nodes} sliders to slip min_slips = {min_slips} times in one "
+            f"avalanche: at least {n_nodes} x {min_slips - 1} + 1 = {needed} slips, more than {what}. Ask fewer."
+        )
+    share = float(normal_load.max() / normal_load.sum())
+    estimate = min_displacement / share
+    if estimate > limit:
+        raise ConfigError(
+            f"The [tilt] table asks the centre of mass to move by min_displacement = {min_displacement:g} mean "
+            f"slip lengths in one avalanche: about {estimate:.3g} slips (a slip of a slider moves it by about "
+            f"its share N_i / sum N <= {share:.3g} of a slip length), more than {what}. Ask less."
+        )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import math
 import os
 from pathlib import Path
 from typing import Any
@@ -11,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from slidernet._validation import check_array
+from slidernet._validation import check_array, is_number_text, read_real
 from slidernet.errors import ConfigError, param_error
 from slidernet.plugins.distributions.law import Distribution
 
@@ -86,9 +85,14 @@ class Empirical(Distribution):
                  if line.strip() and not line.lstrip().startswith("#")]
         index = self.column if isinstance(self.column, int) else 0
         values: list[float] = []
+        width = None  # the number of fields of the first line: every line of a table has as many
         for k, (lineno, line) in enumerate(lines):
             row = next(csv.reader([line], delimiter=self.delimiter))
             where = f"{str(path)!r}, line {lineno}"
+            width = len(row) if width is None else width
+            if len(row) != width:
+                raise ConfigError(f"The 'path' parameter of empirical: {where}: {len(row)} fields; the first line "
+                                  f"has {width}.")
             if k == 0 and isinstance(self.column, str):
                 names = [f.strip() for f in row]
                 if self.column not in names:
@@ -101,18 +105,13 @@ class Empirical(Distribution):
             if index >= len(row):
                 raise ConfigError(f"The 'column' parameter of empirical: {where} has no column {index} "
                                   f"(only {len(row)} fields).")
-            field = row[index].strip()
             try:
-                value = float(field)
-            except ValueError:
-                if k == 0:  # a header
+                values.append(read_real(row[index].strip(), "the value",
+                                        f"The 'path' parameter of empirical: {where}"))
+            except ConfigError:
+                if k == 0 and not is_number_text(row[index]):  # a header
                     continue
-                raise ConfigError(f"The 'path' parameter of empirical: {where}: {field!r} is not a number.") \
-                    from None
-            if not math.isfinite(value):
-                raise ConfigError(f"The 'path' parameter of empirical: {where}: the values must be finite. "
-                                  f"Got {field!r}.")
-            values.append(value)
+                raise
         if len(values) < 2:
             raise param_error("path", "empirical", f"a file with at least 2 values (it has {len(values)})",
                               str(path))
