@@ -23,7 +23,9 @@ from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import (
     CheckpointError,
     OutputError,
+    PluginError,
     RunInterrupted,
+    SchedulerError,
     SlidAwayWarning,
     WorkerLostError,
     param_error,
@@ -243,7 +245,7 @@ def run(
             # temporary file now, which would stay in the folder until the resume.
             store.remove_temporaries()
         store.abandon()  # a run that failed before saving anything leaves the folder as it found it
-        if isinstance(exc, (WorkerLostError, OutputError)) and store.dir.exists():
+        if isinstance(exc, (WorkerLostError, OutputError, SchedulerError, PluginError)) and store.dir.exists():
             raise type(exc)(f"{exc} {_saved_work(store, R)}") from None
         raise
     finally:
@@ -299,40 +301,52 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
-    with StopSignal() as stop:
+    with StopSignal(ex.stop_timeout) as stop:
         results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout)
         try:
-            for r, rec in results:
-                if store is None:
-                    records[r] = rec
-                else:
-                    store.add(r, rec)
-                    if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
-                        store.flush()
-                        last_flush = time.monotonic()
-                bar.update()
-                if on_realization is not None:
-                    on_realization(r)
+            try:
+                for r, rec in results:
+                    if store is None:
+                        records[r] = rec
+                    else:
+                        store.add(r, rec)
+                        if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
+                            store.flush()
+                            last_flush = time.monotonic()
+                    bar.update()
+                    if on_realization is not None:
+                        on_realization(r)
+            finally:
+                bar.close()
+                results.close()  # running realizations stop and save (within the grace) before the pool goes
         except KeyboardInterrupt:
+            # A signal's KeyboardInterrupt (a second one, or the grace ran out), a hook's or a plugin's own
+            # (a run in this process): the run stops as on Ctrl-C. One raised while the realizations saved
+            # lands here too.
             stop.request(signal.SIGINT)
-        finally:
-            results.close()  # running realizations stop and save before the pool goes
-            bar.close()
-        if stop.requested:
-            raise _interrupted(store, R, stop.signum)
+    # Outside the signals' handlers: saving what is finished is not cut by the end of the grace.
+    if stop.requested:
+        raise _interrupted(store, R, stop)
     if store is not None:
         store.flush()
     return records
 
 
-def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:
+def _interrupted(store: RunStore | None, R: int, stop: StopSignal) -> RunInterrupted:
     """Save what is finished; the exception that says what is saved and how to resume."""
-    name = signal.Signals(signum).name
+    name = signal.Signals(stop.signum).name
     if store is None:
         return RunInterrupted(f"interrupted by {name}; nothing was saved (run with an output directory "
-                              "to keep the work of an interrupted run).", signum)
+                              "to keep the work of an interrupted run).", stop.signum)
+    ended = ""
+    if stop.forced:
+        # The workers that were ended are gone: a save one of them was writing is only a temporary file now.
+        store.remove_temporaries()
+        ended = (f" (the realizations still running after execution.stop_timeout = {stop.grace:g} s were ended"
+                 if stop.expired else " (stopped at once by a second signal")
+        ended += "; they resume from their last save)"
     store.flush()
-    return RunInterrupted(f"interrupted by {name}: {_saved_work(store, R)}", signum)
+    return RunInterrupted(f"interrupted by {name}{ended}: {_saved_work(store, R)}", stop.signum)
 
 
 def _saved_work(store: RunStore, R: int) -> str:
