@@ -9,7 +9,10 @@ which tasks finish never change the bits.
 
 While it runs, a task with a ``partial`` path saves its realization there
 every ``every`` seconds (and on Ctrl-C), so a killed run resumes inside a
-long realization rather than at its start.
+long realization rather than at its start. A stopping run gives its running
+tasks :attr:`StopSignal.grace` seconds (``execution.stop_timeout``) to do so;
+those still running then (a plugin that never returns) are ended at their
+last save.
 
 Backends
 --------
@@ -756,8 +759,8 @@ def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str
         error, the caller closing it). None: never requested.
     scheduler_timeout : float
         Seconds to wait for the Dask scheduler before raising
-        :class:`~slidernet.errors.SchedulerError`; also when it goes away
-        during the run.
+        :class:`~slidernet.errors.SchedulerError`, which is also raised when
+        the scheduler goes away during the run.
     """
     stop = StopSignal() if stop is None else stop
     if scheduler is not None:

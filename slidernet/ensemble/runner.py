@@ -161,15 +161,22 @@ def run(
         Before any work, if float64 cannot resolve the scene's slips.
     RunInterrupted
         On Ctrl-C (SIGINT) or SIGTERM: the running realizations stop at
-        their next clean point, and with ``out`` the finished ones and the
-        state of the running ones are saved; its message says how to resume
-        and its ``signum`` which signal stopped the run.
+        their next clean point (those still running after
+        ``execution.stop_timeout`` seconds are ended at their last save),
+        and with ``out`` the finished ones and the state of the running ones
+        are saved; its message says how to resume and its ``signum`` which
+        signal stopped the run. A plugin's own KeyboardInterrupt is SIGINT.
+    PluginError
+        If a plugin's code raises (or calls ``sys.exit``), naming the plugin
+        and its line; or if it returns values that break the contract. With
+        ``out``, the message says what was saved.
     OutputError
         If ``out`` cannot be used as a folder, or holds a finished result
         and ``overwrite`` is not set.
     SchedulerError
         If the Dask scheduler does not answer within
-        ``execution.scheduler_timeout`` seconds.
+        ``execution.scheduler_timeout`` seconds, or goes away during the run
+        (the message then says what was saved and how to resume).
 
     Warns
     -----
