@@ -31,7 +31,9 @@ class PrecisionError(ConfigError):
 
 
 class PluginError(SlidernetError, RuntimeError):
-    """A plugin returned values that break the model's contract (NaN, mu_s <= mu_d, ...)."""
+    """A plugin returned values that break the model's contract (NaN, mu_s <= mu_d, ...), or its own code raised
+    (or called ``sys.exit``): the message names the plugin, where it comes from, the call, the exception and the
+    plugin's line (:mod:`slidernet.plugins.guard`)."""
 
 
 class AvalancheError(SlidernetError, RuntimeError):
@@ -77,7 +79,8 @@ class WorkerLostError(SlidernetError, RuntimeError):
 
 
 class SchedulerError(SlidernetError, ConnectionError):
-    """The Dask scheduler could not be reached within ``execution.scheduler_timeout``."""
+    """The Dask scheduler could not be reached within ``execution.scheduler_timeout``, or went away during the run
+    (the work saved until then is kept, and the run can be resumed)."""
 
 
 class RunInterrupted(KeyboardInterrupt):

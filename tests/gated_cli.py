@@ -10,7 +10,11 @@ in threads). A test thereby holds a run at a known point, with
 every running realization part-way through and checkpointed, while it sends
 a signal or kills the run: it never races the machine's speed. Without the
 variable the law is a plain uniform, so a run's bits do not depend on the
-gate.
+gate. A gate that never opens is a plugin that never returns.
+
+With ``SLIDERNET_TEST_GATE_FAULT`` set, a process at the gate does not wait:
+it raises the plugin's fault instead, ``raise`` (a ValueError), ``exit``
+(``sys.exit(5)``) or ``interrupt`` (KeyboardInterrupt).
 
 Usage: ``python tests/gated_cli.py run CONFIG --out DIR ...`` (the
 arguments of ``slidernet``).
@@ -48,6 +52,13 @@ class Gated:
             Gated.drawn[who] = Gated.drawn.get(who, 0) + size
             if Gated.drawn[who] > int(os.environ["SLIDERNET_TEST_GATE_AFTER"]):
                 Path(gate, f"waiting-{who[0]}-{who[1]}").touch()
+                fault = os.environ.get("SLIDERNET_TEST_GATE_FAULT")
+                if fault == "raise":
+                    raise ValueError("the gate's fault")
+                if fault == "exit":
+                    sys.exit(5)
+                if fault == "interrupt":
+                    raise KeyboardInterrupt
                 while not Path(gate, "open").exists():
                     time.sleep(0.01)
                 Gated.passed.add(who)

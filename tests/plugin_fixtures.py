@@ -1,6 +1,8 @@
-"""Plugins used by test_registry.py as the targets of fake entry points."""
+"""Plugins used by test_registry.py as the targets of fake entry points; broken ones for test_plugin_errors.py."""
 
 from __future__ import annotations
+
+import sys
 
 import numpy as np
 from scipy import special
@@ -42,3 +44,38 @@ class ShortDriver:
     def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:
         return self.sigma_theta * rng.standard_normal(steps)
 
+
+
+class Raising(FakeDist):
+    """A broken plugin: its draws raise (issue 43: the plugin's error, not a bug of slidernet)."""
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        return np.full(size, self.low / 0)
+
+
+class Exiting(FakeDist):
+    """A broken plugin: its draws end the process."""
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        sys.exit(5)
+
+
+class Interrupting(FakeDist):
+    """A plugin that raises KeyboardInterrupt in its draws, as Ctrl-C in its code would."""
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        raise KeyboardInterrupt
+
+
+class BrokenFactory(FakeDist):
+    """A broken plugin: its factory raises."""
+
+    def __init__(self, low: float = 0.55, high: float = 0.65) -> None:
+        raise ValueError(f"cannot make a law on [{low}, {high}]")
+
+
+class RaisingDriver(ShortDriver):
+    """A broken driver: its thetas raise."""
+
+    def thetas(self, rng: np.random.Generator, steps: int) -> np.ndarray:
+        return {}["sigma"]

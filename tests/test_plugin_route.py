@@ -186,10 +186,11 @@ def test_two_forked_workers_import_the_file_and_give_the_same_bits(tmp_path, cle
 
 def test_a_fresh_process_imports_the_file_from_the_config_alone(tmp_path, clean_registries):
     # What a spawned or Dask worker does: load the run's configuration, as JSON, in another folder.
+    # (__class__: the object is the plugin wrapped so that its errors are named as its, plugins.guard.)
     laws = _write(tmp_path / "my_laws.py", LAWS)
     cfg = load_config(_toml(tmp_path / "run.toml", plugins=["my_laws.py"]))
     code = ("import json, sys; from slidernet.ensemble.execution import scene_of; "
-            "scene = scene_of(sys.stdin.read()); print(type(scene.distribution.dist).__module__)")
+            "scene = scene_of(sys.stdin.read()); print(scene.distribution.dist.__class__.__module__)")
     done = subprocess.run([sys.executable, "-c", code], input=json.dumps(cfg.model_dump(mode="json")),
                           capture_output=True, text=True, cwd=_write(tmp_path / "elsewhere" / "x", "").parent,
                           check=False)

@@ -22,7 +22,9 @@ class ExecutionConfig(_Strict):
     Dask distributed cluster instead. ``checkpoint_every`` (seconds) is how
     often a run with an output directory saves its work, and
     ``scheduler_timeout`` (seconds) how long to wait for the scheduler to
-    answer before giving up with a message. Realization r is
+    answer before giving up with a message, ``stop_timeout`` (seconds) how
+    long a stopping run waits for its running realizations to save before
+    it ends them. Realization r is
     always driven by child r of the seed and the ensemble is reduced in
     realization order, so the same config gives the same bits on 1 worker,
     N workers or a cluster; this table is kept out of the identity of a run
@@ -39,6 +41,10 @@ class ExecutionConfig(_Strict):
         60.0, description="Seconds between two saves of the work of a run that has an output directory.")
     scheduler_timeout: PositiveReal = Field(
         10.0, description="Seconds to wait for the Dask scheduler to answer before giving up.")
+    stop_timeout: PositiveReal = Field(
+        10.0, description="Seconds the running realizations get, after Ctrl-C or SIGTERM (or an error), to reach "
+                          "a clean point and save; those still running then (a plugin that never returns) are "
+                          "ended at their last save.")
 
     @field_validator("scheduler")
     @classmethod

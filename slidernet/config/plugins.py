@@ -22,6 +22,7 @@ from slidernet.errors import ConfigError
 from slidernet.kernels.strength import strengthening
 from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
+from slidernet.plugins.guard import build_plugin
 
 
 class PluginSpec(BaseModel):
@@ -155,7 +156,8 @@ def _build_plugin(reg: registry.Registry, spec: PluginSpec, field: str) -> Any:
             f"The '{field}' field: the {reg.kind} {spec.name!r} {fault}. Its parameters are {names}."
         ) from None
     try:
-        return factory(**params)
+        # The plugin's own errors, here and in every later call of its object, are named as its (plugins.guard).
+        return build_plugin(reg, spec.name, factory, params)
     except ConfigError as exc:
         raise ConfigError(f"The '{field}' field: {exc}") from None
 

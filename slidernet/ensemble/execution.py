@@ -9,7 +9,10 @@ which tasks finish never change the bits.
 
 While it runs, a task with a ``partial`` path saves its realization there
 every ``every`` seconds (and on Ctrl-C), so a killed run resumes inside a
-long realization rather than at its start.
+long realization rather than at its start. A stopping run gives its running
+tasks :attr:`StopSignal.grace` seconds (``execution.stop_timeout``) to do so;
+those still running then (a plugin that never returns) are ended at their
+last save.
 
 Backends
 --------
@@ -29,9 +32,11 @@ Backends
 
 from __future__ import annotations
 
+import asyncio
 import ctypes
 import functools
 import json
+import logging
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -50,7 +55,8 @@ from typing import Any
 
 import numpy as np
 
-from slidernet.errors import SchedulerError, WorkerLostError
+from slidernet.config.execution import ExecutionConfig
+from slidernet.errors import SchedulerError, SlidernetError, WorkerLostError
 
 Record = dict[str, Any]
 
@@ -109,28 +115,48 @@ class StopSignal:
     clean point, between two chunks of thermal steps (at most about half a
     second of work) or, within a step, at the next refill of a draw buffer
     (every ``solver.batch`` slips at most), saves its state, and no queued
-    realization starts. A second signal stops at once, raising
-    KeyboardInterrupt where the main thread is: every file is written
-    atomically, so the folder still holds the last saved state of each
-    realization. Outside the main thread (where Python cannot catch
-    signals) this does nothing.
+    realization starts. Realizations that have not stopped ``grace``
+    seconds later (a plugin that never returns, a save that takes longer)
+    are ended: the main thread is sent the signal again, which raises
+    KeyboardInterrupt there, wherever it is (inside a plugin's Python code
+    too), and the backend ends the workers. A second signal does the same
+    at once. Every file is written atomically, so the folder still holds
+    the last saved state of each realization. Outside the main thread
+    (where Python cannot catch signals) this does nothing.
 
     The request belongs to this object: the realizations of its run read it
     (:meth:`is_set`, passed down to :func:`run_realization`), and nothing of
     it outlives the run, so a later run, or a direct call of
     :func:`run_realization`, is never stopped by an earlier one.
 
+    Parameters
+    ----------
+    grace : float, optional
+        Seconds between the first signal and the end of the realizations
+        that have not stopped by then (default: that of
+        ``execution.stop_timeout``).
+
     Attributes
     ----------
     signum : int or None
         The first signal received (``signal.SIGINT`` or ``signal.SIGTERM``).
+    forced : bool
+        True once the run was stopped at once (a second signal, or the grace
+        ran out): the realizations still running were ended at their last save.
+    expired : bool
+        True if the grace ran out before every running realization had stopped.
     """
 
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-    def __init__(self) -> None:
+    def __init__(self, grace: float | None = None) -> None:
+        self.grace = float(ExecutionConfig.model_fields["stop_timeout"].default if grace is None else grace)
         self.signum: int | None = None
+        self.forced = False
+        self.expired = False
         self._previous: dict[int, Any] = {}
+        self._timer: threading.Timer | None = None
+        self._closing = False
 
     @property
     def requested(self) -> bool:
@@ -148,11 +174,33 @@ class StopSignal:
 
     def _handle(self, signum: int, frame: Any) -> None:
         if self.signum is not None:
+            if self._closing:  # the run is over: nothing is left to stop
+                return
+            self.forced = True
             raise KeyboardInterrupt
         self.request(signum)
+        # The main thread may be inside a plugin that never returns: only a signal reaches it there.
+        self._timer = threading.Timer(self.grace, self._expire)
+        self._timer.daemon = True
+        self._timer.start()
         # Said at once: saving can take a moment, and the user should know a second Ctrl-C is heard.
         print(f"slidernet: {signal.Signals(signum).name} received: the running realizations stop at their next "
-              "clean point and are saved; send it again to stop at once.", file=sys.stderr, flush=True)
+              f"clean point and are saved (those still running after {self.grace:g} s, execution.stop_timeout, "
+              "are ended at their last save); send it again to stop at once.", file=sys.stderr, flush=True)
+
+    def _expire(self) -> None:
+        """The grace ran out: the first signal again, to the main thread, whose handler now stops at once."""
+        if self._closing or self.signum is None:
+            return
+        self.expired = True
+        main = threading.main_thread().ident
+        if hasattr(signal, "pthread_kill") and main is not None:
+            # A real signal: it also wakes a main thread blocked in a system call (a plugin's sleep).
+            signal.pthread_kill(main, self.signum)
+        else:  # pragma: no cover - Windows
+            import _thread
+
+            _thread.interrupt_main(self.signum)
 
     def __enter__(self) -> StopSignal:
         if threading.current_thread() is threading.main_thread():
@@ -161,6 +209,10 @@ class StopSignal:
         return self
 
     def __exit__(self, *exc: Any) -> None:
+        self._closing = True
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer.join()  # a signal it was sending meets this object's handler, which lets it go
         for sig, handler in self._previous.items():
             signal.signal(sig, handler)
         self._previous.clear()
@@ -283,24 +335,37 @@ def run_realization(config_json: str, seed: int, r: int, partial: str | None = N
 Task = Callable[[int], tuple]  # r -> the arguments of run_realization
 
 
-def _task(*args: Any) -> tuple[Record, list[tuple[type[Warning], str]]]:
-    """:func:`run_realization` in a worker, with the warnings it raised, for the caller to re-raise.
+TaskResult = tuple[Record | None, list[tuple[type[Warning], str]], bool]
 
-    Without a Dask Event's name among ``args``, the stop is the pool worker's flag.
+
+def _task(*args: Any) -> TaskResult:
+    """:func:`run_realization` in a worker: its records, the warnings it raised (for the caller to re-raise),
+    and whether a plugin raised KeyboardInterrupt in it.
+
+    Without a Dask Event's name among ``args``, the stop is the pool worker's flag. A worker ignores
+    the signals, so a KeyboardInterrupt there is a plugin's own: the caller stops the run as on Ctrl-C
+    (the realization keeps its last save).
     """
     stop = args[6] if len(args) > 6 else (None if _WORKER_STOP is None else _WORKER_STOP.is_set)
     if len(args) > 6:
         _compiled(args[0])  # a Dask worker: a local pool's workers are forked from a parent that compiled
+    record, interrupted = None, False
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        record = run_realization(*args[:6], stop=stop)
-    return record, [(w.category, str(w.message)) for w in caught]
+        try:
+            record = run_realization(*args[:6], stop=stop)
+        except KeyboardInterrupt:
+            interrupted = True
+    return record, [(w.category, str(w.message)) for w in caught], interrupted
 
 
-def _reraise(result: tuple[Record, list[tuple[type[Warning], str]]]) -> Record:
-    record, caught = result
+def _reraise(result: TaskResult, stop: StopSignal) -> Record | None:
+    """The records of a task's result; its warnings raised here; a plugin's KeyboardInterrupt asks ``stop``."""
+    record, caught, interrupted = result
     for category, message in caught:
         warnings.warn(message, category, stacklevel=2)
+    if interrupted:
+        stop.request(signal.SIGINT)
     return record
 
 
@@ -393,6 +458,25 @@ def _terminate(pool: ProcessPoolExecutor) -> None:
         proc.join()  # at once: SIGKILL cannot be caught
 
 
+class _Deadline:
+    """The end of the grace a stopping run gives its running realizations (:attr:`StopSignal.grace` s)."""
+
+    def __init__(self, grace: float) -> None:
+        self.grace = grace
+        self.since: float | None = None
+
+    def start(self) -> bool:
+        """Start the grace, once; True the first time (the caller then tells the tasks to stop)."""
+        if self.since is not None:
+            return False
+        self.since = time.monotonic()
+        return True
+
+    @property
+    def passed(self) -> bool:
+        return self.since is not None and time.monotonic() - self.since > self.grace
+
+
 def _local_pool(indices: Sequence[int], args: Task, workers: int,
                 stop: StopSignal) -> Iterator[tuple[int, Record]]:
     method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
@@ -402,6 +486,7 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
                                initargs=(flag, os.getpid()))
     todo = iter(indices)
     running: dict[Future, int] = {}
+    deadline = _Deadline(stop.grace)
 
     def submit_next() -> bool:
         r = next(todo, None)
@@ -410,26 +495,32 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
         running[pool.submit(_task, *args(r))] = r
         return True
 
+    def stopping() -> None:
+        # Queued tasks see the flag as they start and return at once. None is cancelled here: Python 3.11's
+        # pool thread sets an exception on every pending future when the pool breaks (our kill), and a
+        # cancelled one raised InvalidStateError in that thread, a traceback after a second signal.
+        if deadline.start():
+            flag.set()
+
     forced = False
     try:
         while len(running) < _window(workers) and submit_next():
             pass
         while running:
-            if stop.requested and not flag.is_set():
-                flag.set()
-                for fut in running:
-                    fut.cancel()  # queued tasks; those already handed to a worker return at once
+            if stop.requested:
+                stopping()
+            if deadline.passed:  # tasks that never return (a plugin's endless loop): ended below
+                forced = stop.expired = True
+                break
             done, _ = wait(running, timeout=_POLL, return_when=FIRST_COMPLETED)
             for fut in done:
                 r = running.pop(fut)
-                if fut.cancelled():
-                    continue
                 try:
                     result = fut.result()
                 except BrokenProcessPool:
                     running.clear()
                     raise WorkerLostError(_lost_message(pool)) from None
-                record = _reraise(result)
+                record = _reraise(result, stop)
                 if record is not None:
                     yield r, record
                 if not stop.requested:
@@ -441,13 +532,17 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
         raise
     finally:
         # On any way out (an error, the caller stopping early, a second
-        # Ctrl-C) running realizations are told to stop and save.
-        flag.set()
+        # Ctrl-C) running realizations are told to stop and save, and get
+        # the grace to do so.
+        stopping()
         try:
             # Short waits, not one long join: a signal that the OS hands to
             # another thread reaches Python's handler only when the main
             # thread wakes up.
             while running and not forced:
+                if deadline.passed:
+                    forced = stop.expired = True
+                    break
                 _, pending = wait(running, timeout=_POLL)
                 if not pending:
                     break
@@ -456,8 +551,11 @@ def _local_pool(indices: Sequence[int], args: Task, workers: int,
             raise
         finally:
             if forced:
+                stop.forced = True
                 _terminate(pool)
-            pool.shutdown(wait=not forced, cancel_futures=True)
+            # The pool's thread, which has seen the killed workers, ends on its own (a forced stop) or once
+            # the last task has returned.
+            pool.shutdown(wait=True)
 
 
 # Seconds to wait for the exit status of a worker known to have died (a hang guard: it comes at once).
@@ -500,62 +598,140 @@ def _lost_message(pool: ProcessPoolExecutor) -> str:
     return f"A worker process {how} during the run; the other workers were stopped."
 
 
+class _QuietLostScheduler(logging.Filter):
+    """Drops what distributed's client logs when its scheduler has gone away: the run says it, in one line.
+
+    That is the line "Failed to reconnect to scheduler ..." and, after it, the tracebacks of the
+    client's own closing coroutines, cancelled (``asyncio.CancelledError``). Every other record passes.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.lost = False
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.getMessage().startswith("Failed to reconnect to scheduler"):
+            self.lost = True
+            return False
+        cancelled = record.exc_info is not None and record.exc_info[0] is not None \
+            and issubclass(record.exc_info[0], asyncio.CancelledError)
+        return not (self.lost and cancelled)
+
+
 def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
           timeout: float) -> Iterator[tuple[int, Record]]:
-    from distributed import Client, Event
+    from distributed import Client
+
+    quiet = _QuietLostScheduler()
+    log = logging.getLogger("distributed.client")
+    log.addFilter(quiet)
+    try:
+        try:
+            client = Client(scheduler, timeout=timeout)
+        except (OSError, TimeoutError) as exc:
+            raise SchedulerError(
+                f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
+                f"(execution.scheduler_timeout): {_first_line(exc)}."
+            ) from None
+        with client:
+            try:
+                yield from _dask_tasks(client, indices, args, scheduler, stop)
+            except SchedulerError:
+                quiet.lost = True  # before the client closes: its closing, cut off, logs tracebacks
+                raise
+    finally:
+        log.removeFilter(quiet)
+
+
+def _first_line(exc: BaseException) -> str:
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
+def _dask_tasks(client: Any, indices: Sequence[int], args: Task, scheduler: str,
+                stop: StopSignal) -> Iterator[tuple[int, Record]]:
+    """The realizations on the cluster of ``client``; a scheduler that goes away is a SchedulerError."""
+    from concurrent.futures import CancelledError
+
+    from distributed import Event
     from distributed import wait as dask_wait
+    from distributed.comm.core import CommClosedError
+
+    workers = max(1, sum(client.nthreads().values()))
+    name = f"slidernet-stop-{uuid.uuid4().hex}"
+    event = Event(name, client=client)
+    todo = iter(indices)
+    running: dict[Any, int] = {}
+    deadline = _Deadline(stop.grace)
+    lost = at_once = False
+
+    def submit_next() -> bool:
+        r = next(todo, None)
+        if r is None:
+            return False
+        running[client.submit(_task, *args(r), name, pure=False)] = r
+        return True
+
+    def stopping() -> None:
+        if deadline.start():
+            event.set()  # queued tasks see it as they start and return at once
+
+    def waited(return_when: str) -> list[Any]:
+        try:
+            return list(dask_wait(list(running), timeout=_POLL, return_when=return_when).done)
+        except TimeoutError:  # the wait's own timeout (a lost connection is another OSError)
+            return []
 
     try:
-        client = Client(scheduler, timeout=timeout)
-    except (OSError, TimeoutError) as exc:
-        raise SchedulerError(
-            f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
-            f"(execution.scheduler_timeout): {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}."
-        ) from None
-    with client:
-        workers = max(1, sum(client.nthreads().values()))
-        name = f"slidernet-stop-{uuid.uuid4().hex}"
-        event = Event(name, client=client)
-        todo = iter(indices)
-        running: dict[Any, int] = {}
-
-        def submit_next() -> bool:
-            r = next(todo, None)
-            if r is None:
-                return False
-            running[client.submit(_task, *args(r), name, pure=False)] = r
-            return True
-
+        while len(running) < _window(workers) and submit_next():
+            pass
+        while running:
+            if stop.requested:
+                stopping()
+            if deadline.passed:
+                break
+            for fut in waited("FIRST_COMPLETED"):
+                r = running.pop(fut)
+                record = _reraise(fut.result(), stop)
+                fut.release()
+                if record is not None:
+                    yield r, record
+                if not stop.requested:
+                    submit_next()
+    except (OSError, CancelledError, asyncio.CancelledError) as exc:
+        # A task's own error passes (slidernet's errors, anything raised while the scheduler answers);
+        # a closed connection, a connection that cannot be made again, the futures that a client cut
+        # off from its scheduler cancels: the scheduler went away.
+        if isinstance(exc, SlidernetError) or (client.status == "running" and not isinstance(
+                exc, (CommClosedError, CancelledError, asyncio.CancelledError))):
+            raise
+        lost = True
+        cut = isinstance(exc, (CommClosedError, CancelledError, asyncio.CancelledError))
+        raise SchedulerError(f"The Dask scheduler at {scheduler!r} went away during the run "
+                             f"({'the connection to it was lost' if cut else _first_line(exc)}).") from None
+    except KeyboardInterrupt:  # a second Ctrl-C, or the grace ran out (StopSignal)
+        at_once = True
+        raise
+    finally:
+        # Running tasks save and return; short waits keep the main thread awake for a second signal.
+        # With no scheduler there is nobody left to tell.
         try:
-            while len(running) < _window(workers) and submit_next():
-                pass
-            while running:
-                if stop.requested and not event.is_set():
-                    # Queued tasks see the event as they start and return at once.
-                    event.set()
-                try:
-                    done, _ = dask_wait(list(running), timeout=_POLL, return_when="FIRST_COMPLETED")
-                except TimeoutError:
-                    continue
-                for fut in done:
-                    r = running.pop(fut)
-                    record = _reraise(fut.result())
-                    fut.release()
-                    if record is not None:
-                        yield r, record
-                    if not stop.requested:
-                        submit_next()
-        finally:
-            # Running tasks save and return; short waits keep the main thread awake for a second signal.
-            event.set()
+            if not (lost or at_once):
+                stopping()
+                while running and not deadline.passed:
+                    if len(waited("ALL_COMPLETED")) == len(running):
+                        running.clear()
+        except KeyboardInterrupt:  # a second Ctrl-C: the tasks still running are left below
+            pass
+        except (OSError, CancelledError, asyncio.CancelledError):
+            lost = True  # the error that brought us here says what happened
+        if running and not lost:
+            # A task that never returns (a plugin's endless loop) holds a thread of its worker, which no
+            # one can end from here: its future is cancelled, and the run ends without it.
+            stop.forced = True
+            stop.expired = stop.expired or deadline.passed
             try:
-                while running:
-                    try:
-                        dask_wait(list(running), timeout=_POLL)
-                        break
-                    except TimeoutError:
-                        continue
-            except KeyboardInterrupt:
+                client.cancel(list(running))
+            except (OSError, CancelledError, asyncio.CancelledError):
                 pass
 
 
@@ -576,10 +752,15 @@ def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str
     stop : StopSignal, optional
         Once it is requested no realization starts, and the running ones
         stop at a clean point, save, and are not yielded; the iteration then
-        ends. None: never requested.
+        ends. Those still running ``stop.grace`` seconds later (a plugin that
+        never returns) are ended: a local worker is killed, a Dask task's
+        future cancelled, and ``stop.forced`` set. The same grace bounds the
+        wait for the running realizations when the iteration ends early (an
+        error, the caller closing it). None: never requested.
     scheduler_timeout : float
         Seconds to wait for the Dask scheduler before raising
-        :class:`~slidernet.errors.SchedulerError`.
+        :class:`~slidernet.errors.SchedulerError`, which is also raised when
+        the scheduler goes away during the run.
     """
     stop = StopSignal() if stop is None else stop
     if scheduler is not None:

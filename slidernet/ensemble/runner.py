@@ -24,7 +24,9 @@ from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import (
     CheckpointError,
     OutputError,
+    PluginError,
     RunInterrupted,
+    SchedulerError,
     SlidAwayWarning,
     WorkerLostError,
     param_error,
@@ -171,9 +173,15 @@ def run(
         Before any work, if float64 cannot resolve the scene's slips.
     RunInterrupted
         On Ctrl-C (SIGINT) or SIGTERM: the running realizations stop at
-        their next clean point, and with ``out`` the finished ones and the
-        state of the running ones are saved; its message says how to resume
-        and its ``signum`` which signal stopped the run.
+        their next clean point (those still running after
+        ``execution.stop_timeout`` seconds are ended at their last save),
+        and with ``out`` the finished ones and the state of the running ones
+        are saved; its message says how to resume and its ``signum`` which
+        signal stopped the run. A plugin's own KeyboardInterrupt is SIGINT.
+    PluginError
+        If a plugin's code raises (or calls ``sys.exit``), naming the plugin
+        and its line; or if it returns values that break the contract. With
+        ``out``, the message says what was saved.
     OutputError
         If ``out`` cannot be used as a folder, holds a sweep or a paper
         reproduction, or holds a finished result and ``overwrite`` is not
@@ -182,7 +190,8 @@ def run(
         If another command works in ``out`` (it holds the folder's lock).
     SchedulerError
         If the Dask scheduler does not answer within
-        ``execution.scheduler_timeout`` seconds.
+        ``execution.scheduler_timeout`` seconds, or goes away during the run
+        (the message then says what was saved and how to resume).
 
     Warns
     -----
@@ -261,7 +270,7 @@ def run(
             # temporary file now, which would stay in the folder until the resume.
             store.remove_temporaries()
         store.abandon()  # a run that failed before saving anything leaves the folder as it found it
-        if isinstance(exc, (WorkerLostError, OutputError)) and store.dir.exists():
+        if isinstance(exc, (WorkerLostError, OutputError, SchedulerError, PluginError)) and store.dir.exists():
             raise type(exc)(f"{exc} {_saved_work(store, R)}") from None
         raise
     finally:
@@ -317,40 +326,52 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
-    with StopSignal() as stop:
+    with StopSignal(ex.stop_timeout) as stop:
         results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout)
         try:
-            for r, rec in results:
-                if store is None:
-                    records[r] = rec
-                else:
-                    store.add(r, rec)
-                    if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
-                        store.flush()
-                        last_flush = time.monotonic()
-                bar.update()
-                if on_realization is not None:
-                    on_realization(r)
+            try:
+                for r, rec in results:
+                    if store is None:
+                        records[r] = rec
+                    else:
+                        store.add(r, rec)
+                        if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
+                            store.flush()
+                            last_flush = time.monotonic()
+                    bar.update()
+                    if on_realization is not None:
+                        on_realization(r)
+            finally:
+                bar.close()
+                results.close()  # running realizations stop and save (within the grace) before the pool goes
         except KeyboardInterrupt:
+            # A signal's KeyboardInterrupt (a second one, or the grace ran out), a hook's or a plugin's own
+            # (a run in this process): the run stops as on Ctrl-C. One raised while the realizations saved
+            # lands here too.
             stop.request(signal.SIGINT)
-        finally:
-            results.close()  # running realizations stop and save before the pool goes
-            bar.close()
-        if stop.requested:
-            raise _interrupted(store, R, stop.signum)
+    # Outside the signals' handlers: saving what is finished is not cut by the end of the grace.
+    if stop.requested:
+        raise _interrupted(store, R, stop)
     if store is not None:
         store.flush()
     return records
 
 
-def _interrupted(store: RunStore | None, R: int, signum: int) -> RunInterrupted:
+def _interrupted(store: RunStore | None, R: int, stop: StopSignal) -> RunInterrupted:
     """Save what is finished; the exception that says what is saved and how to resume."""
-    name = signal.Signals(signum).name
+    name = signal.Signals(stop.signum).name
     if store is None:
         return RunInterrupted(f"interrupted by {name}; nothing was saved (run with an output directory "
-                              "to keep the work of an interrupted run).", signum)
+                              "to keep the work of an interrupted run).", stop.signum)
+    ended = ""
+    if stop.forced:
+        # The workers that were ended are gone: a save one of them was writing is only a temporary file now.
+        store.remove_temporaries()
+        ended = (f" (the realizations still running after execution.stop_timeout = {stop.grace:g} s were ended"
+                 if stop.expired else " (stopped at once by a second signal")
+        ended += "; they resume from their last save)"
     store.flush()
-    return RunInterrupted(f"interrupted by {name}: {_saved_work(store, R)}", signum)
+    return RunInterrupted(f"interrupted by {name}{ended}: {_saved_work(store, R)}", stop.signum)
 
 
 def _saved_work(store: RunStore, R: int) -> str:
