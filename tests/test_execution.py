@@ -157,6 +157,12 @@ def test_bad_scheduler_is_refused_before_any_work(address):
         slidernet.run(PAIR, scheduler=address)
 
 
+def test_a_bad_scheduler_argument_says_why():
+    with pytest.raises(ConfigError, match=r"^The 'scheduler' parameter of run must be .* Got 'tcp://localhost' "
+                                          r"instead: missing port number in address 'localhost'\.$"):
+        slidernet.run(PAIR, scheduler="tcp://localhost")
+
+
 def test_execution_is_not_part_of_the_recorded_config():
     ds = slidernet.run({**PAIR, "realizations": 2, "steps": 10, "execution": {"workers": 2}})
     assert "execution" not in json.loads(ds.attrs["config"])

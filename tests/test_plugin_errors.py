@@ -111,3 +111,19 @@ def test_a_built_in_is_called_as_it_is():
     # An error of a built-in is a bug of slidernet: it keeps its traceback (exit 1).
     cfg = {**_config(), "friction": {"mu_d": 0.5, "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}}}
     assert type(load_config(cfg).distribution().dist) is Gaussian
+
+
+@pytest.mark.parametrize("code", [3, "bye"], ids=["status", "message"])
+def test_a_plugin_file_that_exits_while_imported_is_the_plugins_error(tmp_path, capsys, code):
+    # Such a file ended the command with its own status and no word (a SystemExit passed the loader).
+    plugin = tmp_path / "quits.py"
+    plugin.write_text(f"import sys\nsys.exit({code!r})\n")
+    config = tmp_path / "run.toml"
+    config.write_text('plugins = ["quits.py"]\n[network]\nkind = "two_slider"\nNtilde = 1e-7\n[friction]\n'
+                      'mu_d = 0.5\n[friction.static]\nname = "gaussian"\nmean = 0.6\nstd = 0.01\n[driver]\n'
+                      'name = "gaussian_steps"\nsigma_theta = 1e-6\n')
+    assert main(["run", str(config), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("slidernet: error: ") and err.count("\n") == 1
+    assert f"it called sys.exit({code!r}) while being imported" in err
+    assert not (tmp_path / "out").exists()

@@ -628,7 +628,7 @@ def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
     try:
         try:
             client = Client(scheduler, timeout=timeout)
-        except (OSError, TimeoutError) as exc:
+        except Exception as exc:  # unreachable, refused, or misconfigured (TLS): the user's to fix, in one line
             raise SchedulerError(
                 f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
                 f"(execution.scheduler_timeout): {_first_line(exc)}."

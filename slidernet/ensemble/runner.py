@@ -17,12 +17,14 @@ from tqdm.auto import tqdm
 from slidernet._paths import absolute_path
 from slidernet._version import __version__, code_digest
 from slidernet.analysis.observables import CHUNK, assemble
-from slidernet.config import SCHEDULER_REQUIREMENT, Config, is_scheduler_address, load_config
+from slidernet.config import SCHEDULER_REQUIREMENT, Config, load_config
+from slidernet.config.execution import scheduler_address_problem
 from slidernet.config.loading import input_files
 from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
 from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import (
     CheckpointError,
+    ConfigError,
     OutputError,
     PluginError,
     RunInterrupted,
@@ -216,8 +218,10 @@ def run(
     ex = cfg.execution
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise param_error("workers", "run", "an integer >= 1", workers)
-    if scheduler is not None and not is_scheduler_address(scheduler):
-        raise param_error("scheduler", "run", SCHEDULER_REQUIREMENT, scheduler)
+    problem = None if scheduler is None else scheduler_address_problem(scheduler)
+    if problem is not None:
+        refused = str(param_error("scheduler", "run", SCHEDULER_REQUIREMENT, scheduler))
+        raise ConfigError(f"{refused[:-1]}: {problem}.")
     if scheduler_timeout is not None and (isinstance(scheduler_timeout, bool)
                                           or not isinstance(scheduler_timeout, (int, float))
                                           or not scheduler_timeout > 0):

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from slidernet.errors import PluginError, SlidernetError
-from slidernet.plugins.loader import _reason
+from slidernet.plugins.loader import exception_line
 from slidernet.plugins.registry import Registry
 
 
@@ -104,7 +104,7 @@ def _call(label: str, source: Path | None, call: str, fn: Callable[..., Any], *a
     except Exception as exc:
         # The plugin's frames only: the line is the plugin's, never this function's.
         tb = exc.__traceback__.tb_next if exc.__traceback__ is not None else None
-        raise PluginError(f"{label} failed in {call}: {_reason(exc.with_traceback(tb), source)}") from exc
+        raise PluginError(f"{label} failed in {call}: {exception_line(exc.with_traceback(tb), source)}") from exc
 
 
 class _Guarded:

@@ -161,8 +161,10 @@ def _import_module(entry: str, field: str) -> ModuleType:
         else:  # the module exists, and one of its own imports failed
             hint = f", which {entry!r} imports."
         raise ConfigError(f"The {field}: cannot import {entry!r}: {exc}{hint}") from exc
+    except SystemExit as exc:
+        raise ConfigError(_exit_message(field, entry, exc)) from None
     except Exception as exc:  # anything the module raises at import: say what and where
-        raise ConfigError(f"The {field}: cannot import {entry!r}: {_reason(exc)}") from exc
+        raise ConfigError(f"The {field}: cannot import {entry!r}: {exception_line(exc)}") from exc
 
 
 def _import_file(entry: str, field: str) -> ModuleType:
@@ -186,13 +188,23 @@ def _import_file(entry: str, field: str) -> ModuleType:
     sys.modules[name] = module
     try:
         spec.loader.exec_module(module)
+    except SystemExit as exc:
+        del sys.modules[name]
+        raise ConfigError(_exit_message(field, entry, exc)) from None
     except Exception as exc:
         del sys.modules[name]  # a failed import leaves nothing behind: fixing the file and retrying works
-        raise ConfigError(f"The {field}: cannot import {entry!r}: {_reason(exc, path.resolve())}") from exc
+        raise ConfigError(f"The {field}: cannot import {entry!r}: {exception_line(exc, path.resolve())}") from exc
     return module
 
 
-def _reason(exc: BaseException, source: Path | None = None) -> str:
+def _exit_message(field: str, entry: str, exc: SystemExit) -> str:
+    # A plugin that ends the process at import would end the run without a word (exit 3, say): it is the
+    # plugin's error, said as one. KeyboardInterrupt passes: it stops the command as Ctrl-C does.
+    return (f"The {field}: cannot import {entry!r}: it called sys.exit({exc.code!r}) while being imported; a "
+            "plugin may not end the process (raise an exception instead).")
+
+
+def exception_line(exc: BaseException, source: Path | None = None) -> str:
     """An exception raised at import as one line: its type, message, and the line that raised it.
 
     The line is the last one of ``source`` (the plugin file) in the traceback, where there is one:
