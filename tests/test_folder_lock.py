@@ -197,3 +197,20 @@ def test_a_lock_file_of_a_killed_command_is_taken_over(finished):
     slidernet.run(BASE, out=finished, overwrite=True, **ONE).close()
     assert _tree(finished) == ["result.nc"]
 
+
+
+def test_a_finished_run_leaves_no_lock_file_from_the_moment_its_checkpoint_goes(tmp_path, monkeypatch):
+    # The result is opened after the checkpoint is removed and before the lock is let go: a kill -9 there
+    # (seen in benchmarks/fault_injection.py) left the lock file beside result.nc for good.
+    from slidernet.ensemble import runner
+
+    seen: list[list[str]] = []
+    opened = runner.open_result
+
+    def open_result(path):
+        seen.append(sorted(os.listdir(path.parent)))
+        return opened(path)
+
+    monkeypatch.setattr(runner, "open_result", open_result)
+    slidernet.run(BASE, out=tmp_path / "out", **ONE).close()
+    assert seen == [["result.nc"]]

@@ -622,6 +622,11 @@ class RunStore:
             os.rename(self.dir, gone)
         except FileNotFoundError:
             return
+        # The folder now holds the finished run alone: its lock file goes at once, before the files are
+        # removed (which can take seconds), so that a kill from here on leaves no lock file beside
+        # result.nc; the lock itself is held until close(), and whoever locks the folder meanwhile finds
+        # the finished run.
+        self._lock.path.unlink(missing_ok=True)
         shutil.rmtree(gone, ignore_errors=True)
 
 
