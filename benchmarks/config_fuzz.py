@@ -16,7 +16,8 @@ A case passes when:
 - it exits 0, its folder holds only ``result.nc``, and ``n``, ``mu_max``,
   ``x_G`` (and ``y_G``) are finite there; or
 - it exits 2 with ``slidernet: error:`` lines and no traceback, and leaves no
-  folder behind (or an empty one); or
+  folder behind, or a checkpoint of the work it saved before the error,
+  which its line names; or
 - it runs past ``--case-timeout`` seconds having said it would be slow (a
   ``slidernet: warning:`` line) or with a slow-run estimate of at least a
   tenth of the timeout (:func:`slidernet.solver.budget.warn_if_slow`'s
@@ -396,11 +397,13 @@ def run_case(case: Case, workers: int, timeout: float, stop_timeout: float) -> C
     elif case.rc == 2:
         lines = [line for line in stderr.splitlines() if line.strip()]
         first = next((i for i, line in enumerate(lines) if line.startswith("slidernet: error:")), None)
-        case.ok = first is not None and "Traceback" not in stderr and not left
+        # A run that fails after saving work keeps it (a resumable checkpoint) and its line says where.
+        kept = left == ["checkpoint"] and (out / "checkpoint" / "run.json").exists() and "checkpoint" in stderr
+        case.ok = first is not None and "Traceback" not in stderr and (not left or kept)
         case.status = "refused" if case.ok else "refused, badly"
         case.detail = (" ".join(lines[first:first + 2])[len("slidernet: error: "):] if first is not None
                        else stderr.strip()[-400:])
-        if left:
+        if left and not kept:
             case.detail += f" (left in the folder: {left})"
     else:
         case.status = "crash" if case.rc == 1 else f"rc {case.rc}"

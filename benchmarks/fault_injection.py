@@ -318,7 +318,11 @@ def fault_shared_folder(folder: Path, config: Path, reference: Path) -> tuple[bo
     return True, "; ".join(notes)
 
 
-HANG_PLUGIN = """\"\"\"gaussian_steps; it never returns once a file HANG is in its working folder.\"\"\"
+HANG_PLUGIN = """\"\"\"gaussian_steps; a realization's call never returns once a file HANG is in its working folder.
+
+The checks before the run draw 2**16 values and the kernels' probe 2: only a realization asks for the run's
+own steps (20 000).
+\"\"\"
 import os
 import time
 
@@ -328,7 +332,7 @@ from slidernet.plugins.drivers import GaussianSteps
 
 class MaybeHanging(GaussianSteps):
     def thetas(self, rng, steps):
-        if os.path.exists("HANG"):
+        if os.path.exists("HANG") and steps == 20000:
             open(f"hanging-{os.getpid()}", "w").close()
             while True:
                 time.sleep(3600)

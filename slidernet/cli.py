@@ -27,8 +27,8 @@ Exit status, one rule for every subcommand:
 - 1: a bug of slidernet's, an error nobody foresaw: Python's traceback, then
   one line asking to report it;
 - 128 + the signal's number: stopped by a signal, as a shell reports it (130
-  for Ctrl-C, also while the command starts; 143 for SIGTERM; 141 for an
-  output pipe closed early, SIGPIPE).
+  for Ctrl-C, 143 for SIGTERM, each also while the command starts, with one
+  line; 141 for an output pipe closed early, SIGPIPE).
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ import contextlib
 import os
 import signal
 import sys
+import threading
 import traceback
 import warnings
 from collections.abc import Iterator, Sequence
@@ -367,6 +368,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     starts is one line and exit 130, as it is later.
     """
     started = False
+    # A batch system ends a job with one SIGTERM: before and after a run (whose StopSignal has handlers of its
+    # own) it says so in one line, as Ctrl-C does, rather than ending the process without a word.
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminated) if in_main else None
     try:
         with _one_line_warnings():
             args = _parser().parse_args(argv)
@@ -382,13 +387,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RunInterrupted as exc:
         print(f"slidernet: {exc}", file=sys.stderr)
         return EXIT_SIGNAL + exc.signum
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        what = "terminated by SIGTERM" if isinstance(exc, _Terminated) else "interrupted"
         if not started:
-            print("slidernet: interrupted while starting; nothing was done.", file=sys.stderr)
+            print(f"slidernet: {what} while starting; nothing was done.", file=sys.stderr)
         else:
-            print("slidernet: interrupted; files already written are complete, nothing else was saved.",
+            print(f"slidernet: {what}; files already written are complete, nothing else was saved.",
                   file=sys.stderr)
-        return EXIT_SIGNAL + signal.SIGINT
+        return EXIT_SIGNAL + (signal.SIGTERM if isinstance(exc, _Terminated) else signal.SIGINT)
     except BrokenPipeError:
         # The reader went away (`slidernet units ... | head`): say so once, on stderr, and make
         # the interpreter's own flush of stdout at exit write nowhere instead of raising again.
@@ -409,6 +415,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("slidernet: internal error: this is a bug of slidernet; please report it with the lines above.",
               file=sys.stderr)
         return EXIT_BUG
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM outside a run: it stops the command as Ctrl-C does, with its own words and status (143)."""
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise _Terminated
 
 
 @contextlib.contextmanager

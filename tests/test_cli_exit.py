@@ -20,10 +20,12 @@ from slidernet import cli
 from slidernet.errors import SlowRunWarning
 from tests.test_output_folders import SMALL  # a run of two sliders, 2 realizations of 50 steps
 
-# Runs the command with a finder in front of Python's import system that sends SIGINT to this process when the
-# module named by argv[1] is about to be imported: Ctrl-C at a known point of the start-up, on any machine.
+# Runs the command with a finder in front of Python's import system that sends SIGINT (or the signal named by
+# SLIDERNET_TEST_SIGNAL) to this process when the module named by argv[1] is about to be imported: Ctrl-C at a
+# known point of the start-up, on any machine.
 CTRL_C_AT_IMPORT = textwrap.dedent("""\
     import importlib.abc, os, signal, sys
+    SIGNAL = getattr(signal, os.environ.get("SLIDERNET_TEST_SIGNAL", "SIGINT"))
 
     # Python's own Ctrl-C handler, as in a terminal: a process started in the background by a shell without job
     # control (nohup, `cmd &` in a script, some CI runners) inherits SIGINT ignored, and would never see it.
@@ -32,7 +34,7 @@ CTRL_C_AT_IMPORT = textwrap.dedent("""\
     class CtrlC(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path, target=None):
             if name == sys.argv[1]:
-                os.kill(os.getpid(), signal.SIGINT)  # Python raises KeyboardInterrupt at its next check
+                os.kill(os.getpid(), SIGNAL)  # Python runs the handler (KeyboardInterrupt) at its next check
             return None
 
     sys.meta_path.insert(0, CtrlC())
@@ -43,18 +45,23 @@ CTRL_C_AT_IMPORT = textwrap.dedent("""\
 
 @pytest.mark.parametrize(("module", "command", "line"), [
     ("slidernet.model.units", ["units", "--material", "steel", "--size", "0.1"],
-     "slidernet: interrupted while starting; nothing was done."),
+     "slidernet: {what} while starting; nothing was done."),
     ("xarray", ["run", "CONFIG", "--out", "OUT", "--no-progress"],
-     "slidernet: interrupted; files already written are complete, nothing else was saved."),
+     "slidernet: {what}; files already written are complete, nothing else was saved."),
 ], ids=["building-the-parser", "importing-the-runner"])
-def test_ctrl_c_while_the_command_starts_is_one_line_and_exit_130(tmp_path, module, command, line):
+@pytest.mark.parametrize(("name", "what", "status"), [("SIGINT", "interrupted", 130),
+                                                      ("SIGTERM", "terminated by SIGTERM", 143)],
+                         ids=["ctrl-c", "sigterm"])
+def test_a_signal_while_the_command_starts_is_one_line_and_its_status(tmp_path, module, command, line, name, what,
+                                                                      status):
+    # SIGTERM (a batch system's) ended the command with no word before a run had started.
     config = tmp_path / "small.toml"
     config.write_text(SMALL)
     args = [str(config) if a == "CONFIG" else str(tmp_path / "out") if a == "OUT" else a for a in command]
     proc = subprocess.run([sys.executable, "-c", CTRL_C_AT_IMPORT, module, *args], capture_output=True,
-                          text=True, timeout=120)
-    assert proc.returncode == 130, proc.stderr
-    assert proc.stderr.strip().splitlines() == [line], proc.stderr
+                          text=True, timeout=120, env={**os.environ, "SLIDERNET_TEST_SIGNAL": name})
+    assert proc.returncode == status, proc.stderr
+    assert proc.stderr.strip().splitlines() == [line.format(what=what)], proc.stderr
     assert not (tmp_path / "out").exists()
 
 

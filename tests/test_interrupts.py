@@ -534,7 +534,12 @@ def test_a_plugins_fault_is_one_line_and_leaves_a_resumable_folder(tmp_path, con
     assert rc == status and "Traceback" not in err and err.count("\n") == 1, err
     found = GATED_LINE.sub("WHERE", err)
     assert found.startswith(line.format(path=GATED_CLI.resolve(), where="WHERE", workers=workers)), err
-    assert "--resume" in err
+    # A plugin's error recurs on the same configuration: the line says what a resume needs, and that a fixed
+    # plugin file is another run; a KeyboardInterrupt is a stop, continued with --resume.
+    resumes = ("continues them once the cause is fixed outside the configuration and its files; a changed "
+               "configuration or plugin file is another run: start it with --overwrite." if status == 2
+               else "; continue with --resume on the same command")
+    assert "--resume" in err and resumes in err, err
     _assert_consistent(out / "checkpoint")
     assert len(list((out / "checkpoint").glob("partial-*.npz"))) == workers
     if fault == "interrupt" and workers == 2:  # as after Ctrl-C

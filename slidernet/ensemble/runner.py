@@ -26,10 +26,10 @@ from slidernet.errors import (
     CheckpointError,
     ConfigError,
     OutputError,
-    PluginError,
     RunInterrupted,
     SchedulerError,
     SlidAwayWarning,
+    SlidernetError,
     WorkerLostError,
     param_error,
 )
@@ -274,8 +274,12 @@ def run(
             # temporary file now, which would stay in the folder until the resume.
             store.remove_temporaries()
         store.abandon()  # a run that failed before saving anything leaves the folder as it found it
-        if isinstance(exc, (WorkerLostError, OutputError, SchedulerError, PluginError)) and store.dir.exists():
-            raise type(exc)(f"{exc} {_saved_work(store, R)}") from None
+        if isinstance(exc, SlidernetError) and store.dir.exists():
+            # What the failed run saved stays, and the line says where. A lost worker or scheduler, or a
+            # full disk, is outside the run: --resume continues it. Any other error (a plugin's, an
+            # avalanche past solver.max_avalanche) recurs on the same configuration, which a fix changes.
+            outside = isinstance(exc, (WorkerLostError, OutputError, SchedulerError))
+            raise type(exc)(f"{exc} {_saved_work(store, R, resumable=outside)}") from None
         raise
     finally:
         if store is not None:
@@ -378,14 +382,21 @@ def _interrupted(store: RunStore | None, R: int, stop: StopSignal) -> RunInterru
     return RunInterrupted(f"interrupted by {name}{ended}: {_saved_work(store, R)}", stop.signum)
 
 
-def _saved_work(store: RunStore, R: int) -> str:
-    """What the checkpoint folder holds, and the command that continues the run."""
+def _saved_work(store: RunStore, R: int, resumable: bool = True) -> str:
+    """What the checkpoint folder holds, and the command that continues the run.
+
+    ``resumable=False``: the run stopped on an error that the same configuration meets again; the line
+    says that a fix outside the configuration and its files resumes, and that any other starts again.
+    """
     saved = len(store.done(strict=False))
     running = store.partials()
-    return (f"{saved} of {R} realizations are finished"
-            + (f" and {running} saved in progress" if running else "")
-            + f" in {str(store.dir)!r}; continue with --resume on the same command, "
-            f"e.g. `slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`.")
+    held = (f"{saved} of {R} realizations are finished"
+            + (f" and {running} saved in progress" if running else "") + f" in {str(store.dir)!r}")
+    command = f"`slidernet run CONFIG --out {str(store.dir.parent)!r} --resume`"
+    if resumable:
+        return f"{held}; continue with --resume on the same command, e.g. {command}."
+    return (f"{held}: {command} continues them once the cause is fixed outside the configuration and its "
+            "files; a changed configuration or plugin file is another run: start it with --overwrite.")
 
 
 def run_in(config: Config | Mapping[str, Any] | str | Path, out: str | Path, *, resume: bool = False,
