@@ -318,7 +318,7 @@ def fault_shared_folder(folder: Path, config: Path, reference: Path) -> tuple[bo
     return True, "; ".join(notes)
 
 
-HANG_PLUGIN = """\"\"\"gaussian_steps; a realization's call never returns once a file HANG is in its working folder.
+HANG_PLUGIN = """\"\"\"gaussian_steps, whose realizations never return once a file HANG is in the folder.
 
 The checks before the run draw 2**16 values and the kernels' probe 2: only a realization asks for the run's
 own steps (20 000).
