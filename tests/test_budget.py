@@ -26,6 +26,7 @@ from slidernet.ensemble import runner
 from slidernet.ensemble.sweep import sweep
 from slidernet.errors import ConfigError, PrecisionError, SizeError, SlowRunWarning
 from slidernet.solver import Scene, budget
+from slidernet.solver.backends import BACKENDS
 
 #: A machine's memory for the refusals, the same on every machine that runs the tests.
 MACHINE = 64 * 10**9
@@ -218,3 +219,15 @@ def test_two_sliders_estimate_is_eq_slope_without_its_offset(sigma: float, ratio
     estimate = budget.slips_per_tau(cfg, Scene.from_config(cfg))
     assert estimate == pytest.approx(sigma / (np.sqrt(np.pi) * 0.1), rel=0.02)
     assert estimate / {1.0: 2.887, 10.0: 53.16}[sigma] == pytest.approx(ratio, abs=0.03)
+
+
+def test_the_estimate_counts_the_time_to_build_a_large_network() -> None:
+    # A chain of 5e7 sliders driven for 30 steps was estimated at 5e-5 s and ran for 80 s, building its
+    # network (benchmarks/config_fuzz.py): the estimate now holds the build, SETUP_SECONDS per node.
+    cfg = load_config(config(network={"kind": "chain", "n": 1000, "Ntilde": 1e-7}, steps=30))
+    scene = Scene.from_config(cfg)
+    slips = budget.slips_per_tau(cfg, scene) * cfg.steps * cfg.realizations
+    drive = slips / BACKENDS[scene.kernel].slips_per_second
+    seconds = budget.warn_if_slow(cfg, scene, workers=1)
+    assert seconds == pytest.approx(drive + 1000 * budget.SETUP_SECONDS["chain"], rel=1e-12)
+    assert 1000 * budget.SETUP_SECONDS["chain"] > drive

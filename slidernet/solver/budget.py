@@ -366,6 +366,14 @@ def precision_cause(cfg: Config, s: Scales) -> str:
 #: Estimated seconds above which a run gets a SlowRunWarning.
 SLOW_SECONDS = 3600.0
 
+#: Seconds per node of building a scene (the network, K, g and their checks), by kind of network: measured by
+#: ``python benchmarks/setup_cost.py`` on the 2-core dev machine (2026-11-28), the larger of the times per node
+#: at its two sizes (chains and lattices of 1e6 and 5e6 nodes, irregular networks of 1e5 and 1e6), rounded
+#: up. A network of 5e7 sliders takes longer to build than to drive for a few steps. A graph file counts as
+#: an irregular network.
+SETUP_SECONDS = {"two_slider": 0.0, "chain": 0.5e-6, "square": 0.35e-6, "triangular": 0.4e-6, "irregular": 12e-6,
+                 "graph": 12e-6}
+
 
 def slips_per_tau(cfg: Config, scene: Scene, found: Scales | None = None) -> float:
     """Estimated rearrangements per tau_th of one realization, from eq. ``slope`` applied to each driven node.
@@ -398,7 +406,8 @@ def warn_if_slow(cfg: Config, scene: Scene, workers: int = 1, found: Scales | No
     """Warn once (:class:`~slidernet.errors.SlowRunWarning`) if the run would take more than an hour.
 
     The estimate is ``realizations x steps x`` :func:`slips_per_tau`, at the backend's ``slips_per_second`` per
-    worker (the pair kernel's, or the network kernels'), on ``min(workers, realizations)`` workers.
+    worker (the pair kernel's, or the network kernels'), on ``min(workers, realizations)`` workers, plus the
+    time to build the scene, :data:`SETUP_SECONDS` per node.
 
     Returns
     -------
@@ -409,13 +418,16 @@ def warn_if_slow(cfg: Config, scene: Scene, workers: int = 1, found: Scales | No
     slips = rate * cfg.steps * cfg.realizations
     per_second = BACKENDS[scene.kernel].slips_per_second
     parallel = min(int(workers), cfg.realizations)
-    seconds = slips / (per_second * parallel)
+    setup = SETUP_SECONDS[cfg.network.kind] * scene.network.n_nodes
+    seconds = slips / (per_second * parallel) + setup
     if seconds > SLOW_SECONDS:
         warnings.warn(
             f"This run would take about {_duration(seconds)}: about {rate:.3g} slips per tau_th (eq. slope for "
             f"each driven node) x {cfg.steps:,} steps x {cfg.realizations:,} realizations = {slips:.3g} slips, "
-            f"at {per_second:.3g} slips/s on each of {parallel} worker(s). A smaller sigma_theta / Ntilde, "
-            f"fewer steps or realizations shorten it.",
+            f"at {per_second:.3g} slips/s on each of {parallel} worker(s)"
+            + (f", and {_duration(setup)} to build the network of {scene.network.n_nodes:,} sliders"
+               if setup > 0.1 * seconds else "")
+            + ". A smaller sigma_theta / Ntilde, fewer steps or realizations shorten it.",
             SlowRunWarning, stacklevel=3)
     return seconds
 
