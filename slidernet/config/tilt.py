@@ -6,7 +6,8 @@ load above mu_d (docs/model.md, "The network tilt test"). These keys make
 that rule stricter, so that a result can be checked against the rule it
 rests on: every node must have slipped ``min_slips`` times in that
 avalanche, and its centre of mass must have moved along the tilt by
-``min_displacement`` mean slip lengths. The defaults are the rule itself.
+``min_displacement`` reference slips (one slider held by one spring of the
+mean stiffness). The defaults are the rule itself.
 """
 
 from __future__ import annotations
@@ -25,10 +26,15 @@ class TiltConfig(_Strict):
     ``min_slips = m``: every node has slipped at least m times in that
     avalanche (or m - 1 times and is unstable, about to slip again); 1 is
     the rule of every earlier result. ``min_displacement = X``: the
-    avalanche has also moved the centre of mass along +x by X mean slip
-    lengths of a node, (1 + e) (<mu_s> - mu_d) <N_i> / <K_ii,xx> (e =
-    ``friction.overshoot``), that is by about X slips per node in the
-    direction of the tilt; 0, the default, asks for no displacement. Both
+    avalanche has also moved the centre of mass along +x by X reference
+    slips ell = (1 + e) (<mu_s> - mu_d) <N_i> Ntilde l0 / <k> (e =
+    ``friction.overshoot``, <k> the mean spring stiffness): the slip of one
+    slider held by one spring, the creep observables' reference slip
+    (docs/model.md). A node of a network slips less, held by all its
+    springs (K_ii,xx, near 3 <k> in a large irregular network, whose nodes
+    have six springs on average), so X reference slips are up to about 3 X
+    slips per node along the tilt; 0, the default, asks for no
+    displacement. Both
     apply to the network tilt test only, not to the appendix's test of two
     sliders (``mu_eff_at = "rearrangements"``). A rule that the test's caps
     (max(100 N, 1e5) slips in one avalanche, ``solver.max_avalanche`` in a
@@ -39,8 +45,9 @@ class TiltConfig(_Strict):
     min_slips: Annotated[Integer, Field(ge=1)] = Field(
         1, description="Slips of every node within the sliding avalanche (1: the rule of every earlier result).")
     min_displacement: Annotated[FiniteFloat, Field(ge=0)] = Field(
-        0.0, description="Displacement of the centre of mass along +x within the sliding avalanche, in mean "
-                         "slip lengths of a node (0: none asked).")
+        0.0, description="Displacement of the centre of mass along +x within the sliding avalanche, in "
+                         "reference slips (1 + e)(<mu_s> - mu_d) <N_i> Ntilde l0 / <k> of one slider held by "
+                         "one spring of the mean stiffness <k> (0: none asked).")
 
     def is_default(self) -> bool:
         """True if the table asks for nothing beyond the rule of every earlier result."""
