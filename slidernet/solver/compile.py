@@ -60,7 +60,7 @@ def probe_config(cfg: Config) -> Config | None:
     Only the size changes (a chain of at most 8 sliders, a lattice of at
     most 4 x 4, an irregular network of at most 32; a graph read from a file
     is kept whole), ``solver.max_avalanche`` (2000 slips), Ntilde (raised to
-    the largest |theta| of two steps of the driver where that passes 100
+    the largest ``|theta|`` of two steps of the driver where that passes 100
     Ntilde: a drive of the study's strength, a few slips a step), and a plugin that
     is not a built-in, replaced by a built-in of its kind (a Gaussian law, a
     driver of Gaussian steps), so the probe runs the same compiled kernels as
