@@ -38,6 +38,14 @@ def _per_realization(values: xr.DataArray, owner: str) -> tuple[xr.DataArray, np
     return values, t
 
 
+def _like(other: xr.DataArray, values: xr.DataArray, name: str) -> xr.DataArray:
+    """``other`` as (realization, t), refused unless it has the dims, times and shape of ``values``."""
+    other, _ = _per_realization(other, f"log_trend's {name!r}")
+    if other.shape != values.shape:
+        raise ConfigError(f"log_trend's {name!r} has the shape {other.shape}, the values {values.shape}.")
+    return other
+
+
 def mean_sem(values: ArrayLike) -> tuple[float, float, int]:
     """Mean, standard error and count of per-realization values, their non-finite ones left out.
 
@@ -116,15 +124,23 @@ def grouped_mean_sem(values: ArrayLike, groups: ArrayLike) -> tuple[float, float
 
 
 def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None,
-              against: xr.DataArray | None = None) -> xr.Dataset:
+              against: xr.DataArray | None = None, where: xr.DataArray | None = None) -> xr.Dataset:
     """The slope d(values)/d(ln t) of every realization, and the ensemble's with its standard error.
 
     Each realization r gets its least-squares line values_r(t) = a_r + b_r ln t
-    over the recorded times t_min <= t <= t_max where its value is finite;
+    over the recorded times t_min <= t <= t_max where its value is finite
+    (and ``where`` is True: a window of its own, in slips per node, say);
     the ensemble slope is the mean of the b_r and its standard error
     std(b_r) / sqrt(R), realizations being independent. The values at the
-    first and last of those times get their mean and standard error the same
-    way.
+    first and last times of each realization's window get their mean and
+    standard error the same way.
+
+    A window after the transient is a choice of ``t_min`` and ``t_max`` (10
+    and 1e3 tau_th, say). A window in another variable that each
+    realization reaches at its own times (the slips per node ``s``) is the
+    mask ``where = (s >= 10) & (s <= 1e3)``; the slope is still against ln t
+    unless ``against`` is given too. Where ``where`` keeps every record the
+    result is that without it.
 
     Parameters
     ----------
@@ -137,23 +153,31 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
         Another abscissa, per realization and recorded time, > 0 where
         fitted (the slips per node, say): the slopes are then against its
         logarithm, over the same times. Default: t.
+    where : xarray.DataArray of bool, dims (realization, t), optional
+        Which records each realization may fit, besides t_min <= t <= t_max
+        (a window in a per-realization variable). Default: all.
 
     Returns
     -------
     xarray.Dataset
         ``slope`` (realization,): b_r, in the units of ``values`` per unit of
-        ln t (multiply by ln 10 for a slope per decade); ``slope_mean``,
-        ``slope_sem``; ``start_mean``, ``start_sem``, ``end_mean``,
-        ``end_sem`` (at the first and last fitted times, attributes
-        ``t_start``, ``t_end``); ``realizations`` (R, those with at least two
-        finite values fitted). A realization with fewer than two finite values
-        gets slope NaN and is left out of the means.
+        ln t (multiply by ln 10 for a slope per decade); ``level``
+        (realization,): the mean of the values fitted, which is the line's
+        value at the mean abscissa fitted, in the units of ``values`` (the
+        level a relative rate divides by: :func:`relative_rate`);
+        ``slope_mean``, ``slope_sem``; ``start_mean``, ``start_sem``,
+        ``end_mean``, ``end_sem`` (at the first and last times of each
+        realization's window; attributes ``t_start``, ``t_end``: the first and
+        last times in [t_min, t_max]); ``realizations`` (R, those with at
+        least two finite values fitted). A realization with fewer than two
+        finite values gets slope and level NaN and is left out of the means.
 
     Raises
     ------
     ConfigError
-        If ``values`` lacks the dims or increasing times, ``t_min`` is not > 0, or fewer than two
-        times are left in [t_min, t_max].
+        If ``values`` lacks the dims or increasing times, ``t_min`` is not > 0, fewer than two
+        times are left in [t_min, t_max], or ``against`` or ``where`` is not of the shape of the
+        values (``where``: or not boolean).
 
     Examples
     --------
@@ -177,28 +201,40 @@ def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None =
     if against is None:
         x = np.broadcast_to(np.log(t[keep]), y.shape)
     else:
-        a, _ = _per_realization(against, "log_trend's 'against'")
-        if a.shape != values.shape:
-            raise ConfigError(f"log_trend's 'against' has the shape {a.shape}, the values {values.shape}.")
+        a = _like(against, values, "against").values[:, keep].astype(np.float64)
         with np.errstate(divide="ignore", invalid="ignore"):
-            x = np.log(a.values[:, keep].astype(np.float64))
-    ok = np.isfinite(y) & np.isfinite(x)
+            x = np.log(a)
+    if where is None:
+        window = np.ones(y.shape, dtype=bool)
+    else:
+        mask = _like(where, values, "where")
+        if mask.dtype != bool:
+            raise ConfigError(f"log_trend's 'where' must be boolean; got {mask.dtype}.")
+        window = mask.values[:, keep]
+    ok = window & np.isfinite(y) & np.isfinite(x)
     slope = np.full(y.shape[0], np.nan)
+    level = np.full(y.shape[0], np.nan)
     for r in range(y.shape[0]):
         if ok[r].sum() >= 2:
             xr_, yr = x[r, ok[r]], y[r, ok[r]]
             dx = xr_ - xr_.mean()
             slope[r] = float(dx @ (yr - yr.mean()) / (dx @ dx))
+            level[r] = float(yr.mean())
     fitted = np.isfinite(slope)
     R = int(fitted.sum())
 
+    # Each realization's first and last records in its window (without 'where': the first and last kept).
+    rows = np.arange(y.shape[0])
+    first = np.where(window.any(axis=1), y[rows, window.argmax(axis=1)], np.nan)
+    last = np.where(window.any(axis=1), y[rows, window.shape[1] - 1 - window[:, ::-1].argmax(axis=1)], np.nan)
     s_mean, s_sem, _ = mean_sem(slope)
-    a_mean, a_sem, _ = mean_sem(np.where(fitted, y[:, 0], np.nan))
-    b_mean, b_sem, _ = mean_sem(np.where(fitted, y[:, -1], np.nan))
+    a_mean, a_sem, _ = mean_sem(np.where(fitted, first, np.nan))
+    b_mean, b_sem, _ = mean_sem(np.where(fitted, last, np.nan))
     units = values.attrs.get("units", "")
     out = xr.Dataset(
         {
             "slope": ("realization", slope, {"long_name": "least-squares slope against ln t", "units": units}),
+            "level": ("realization", level, {"long_name": "mean of the values fitted", "units": units}),
             "slope_mean": ((), s_mean, {"long_name": "mean of the per-realization slopes", "units": units}),
             "slope_sem": ((), s_sem, {"long_name": "standard error of slope_mean over the realizations",
                                       "units": units}),
