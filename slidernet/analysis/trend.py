@@ -131,20 +131,19 @@ def _group_means(owner: str, groups: ArrayLike | None, **columns: ArrayLike) -> 
     """Each group's means of the ``columns`` (one value per realization each), over its realizations where
     every column is finite: shape (G, len(columns)), groups in sorted order, a group with no such
     realization left out. ``groups`` None: every realization its own group."""
-    names = list(columns)
-    arrays = [np.asarray(columns[name], dtype=np.float64) for name in names]
-    g = np.arange(arrays[0].size) if groups is None else np.asarray(groups)
-    given = {**dict(zip(names, arrays)), **({"groups": g} if groups is not None else {})}
+    arrays = {name: np.asarray(column, dtype=np.float64) for name, column in columns.items()}
+    g = np.arange(next(iter(arrays.values())).size) if groups is None else np.asarray(groups)
+    given = {**arrays, **({"groups": g} if groups is not None else {})}
     shapes = [a.shape for a in given.values()]
     if len(set(shapes)) != 1 or g.ndim != 1:
         raise ConfigError(f"{owner} needs {' and '.join(given)} of one shape (R,), one value per realization; "
                           f"got {' and '.join(map(str, shapes))}.")
-    v = np.stack(arrays, axis=1)
+    v = np.stack(list(arrays.values()), axis=1)
     finite = np.isfinite(v).all(axis=1)
     if groups is None:
         return v[finite]
     means = [v[(g == key) & finite].mean(axis=0) for key in np.unique(g) if (finite & (g == key)).any()]
-    return np.array(means).reshape(len(means), len(names))
+    return np.array(means).reshape(len(means), len(arrays))
 
 
 def log_trend(values: xr.DataArray, *, t_min: float = 1.0, t_max: float | None = None,
