@@ -46,8 +46,8 @@ from slidernet.errors import ConfigError, param_error
 
 
 def _one_shape(owner: str, what: str, **arrays: ArrayLike) -> list[np.ndarray]:
-    """The ``arrays`` as 1-D float arrays (``groups`` as given), refused unless they share one shape."""
-    out = [np.asarray(a) if name == "groups" else np.asarray(a, dtype=np.float64) for name, a in arrays.items()]
+    """The ``arrays`` as numpy arrays, refused unless they share one 1-D shape."""
+    out = [np.asarray(a) for a in arrays.values()]
     shapes = [a.shape for a in out]
     if len(set(shapes)) != 1 or out[0].ndim != 1:
         names = ", ".join(arrays)
@@ -181,6 +181,7 @@ def variance_components(values: ArrayLike, groups: ArrayLike, *, confidence: flo
     owner = "variance_components"
     confidence = check_scalar(confidence, "confidence", owner, "in (0, 1)")
     v, g = _one_shape(owner, "R", values=values, groups=groups)
+    v = v.astype(np.float64)
     finite = np.isfinite(v)
     members = [v[finite & (g == key)] for key in np.unique(g[finite])]
     G = len(members)
@@ -426,9 +427,10 @@ def meta_regression(estimates: ArrayLike, sems: ArrayLike, x: ArrayLike | None =
 
     w = 1.0 / (s2 + tau2)
     beta, inv, _ = _weighted_fit(y, X, w)
+    dof: float
     if test == "t":
         residuals = y - X @ beta
-        cov, dof = inv * float(w @ residuals**2) / (K - p), float(K - p)
+        cov, dof = inv * float(w @ residuals**2) / (K - p), K - p
     else:
         cov, dof = inv, math.inf
     sem = np.sqrt(np.diag(cov))
@@ -436,7 +438,7 @@ def meta_regression(estimates: ArrayLike, sems: ArrayLike, x: ArrayLike | None =
         coef_p = 2.0 * stats.t.sf(np.abs(beta / sem), dof)
     typical = (K - p) / trace0
     return MetaRegression(
-        coef=beta, coef_sem=sem, coef_p=coef_p, dof=dof if test == "z" else int(dof), cov=cov, tau2=tau2, q=q,
+        coef=beta, coef_sem=sem, coef_p=coef_p, dof=dof, cov=cov, tau2=tau2, q=q,
         q_dof=K - p, q_p=float(stats.chi2.sf(q, K - p)), i2=tau2 / (tau2 + typical), fitted=X @ beta,
         fitted_sem=np.sqrt(np.einsum("ij,jk,ik->i", X, cov, X)), method=method, test=test)
 
