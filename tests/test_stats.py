@@ -264,14 +264,20 @@ def test_tost_size_at_the_margin():
     assert abs(hits / 2000 - 0.05) <= _coverage_tolerance(0.05, 2000)
 
 
-def test_minimum_detectable_effect_by_hand_and_its_power():
-    # dof inf: (z_0.975 + z_0.8) SE = (1.959964 + 0.841621) SE. On 9 dof, a true effect of the MDE makes
-    # the two-sided t test reject with probability 0.8 within 0.02 (noncentral t, exact).
+def test_minimum_detectable_effect_by_hand():
+    # dof inf: (z_0.975 + z_0.8) SE = (1.959964 + 0.841621) SE.
     assert minimum_detectable_effect(0.1, math.inf) == pytest.approx(0.2801585, abs=1e-7)
-    mde = minimum_detectable_effect(1.0, 9)
-    assert mde == pytest.approx(stats.t.ppf(0.975, 9) + stats.t.ppf(0.8, 9), rel=1e-12)
-    crit = stats.t.ppf(0.975, 9)
-    power = stats.nct.sf(crit, 9, mde) + stats.nct.cdf(-crit, 9, mde)
+    by_hand = stats.t.ppf(0.975, 9) + stats.t.ppf(0.8, 9)
+    assert minimum_detectable_effect(1.0, 9) == pytest.approx(by_hand, rel=1e-12)
+
+
+@pytest.mark.parametrize("dof", [3, 7, 30], ids=["3", "7", "30"])
+def test_a_true_effect_of_the_mde_is_found_with_the_power(dof):
+    # A true effect of the MDE (SE 1) makes the two-sided t test reject with probability 0.8 within 0.02
+    # (noncentral t, exact).
+    mde = minimum_detectable_effect(1.0, dof)
+    crit = stats.t.ppf(0.975, dof)
+    power = stats.nct.sf(crit, dof, mde) + stats.nct.cdf(-crit, dof, mde)
     assert abs(power - 0.8) < 0.02
 
 

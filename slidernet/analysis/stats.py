@@ -131,7 +131,7 @@ def variance_components(values: ArrayLike, groups: ArrayLike, *, confidence: flo
       (MS_b - MS_w) / n with MS_b = n var(geometry means). Its interval is
       the modified large-sample one (Graybill & Wang; Burdick & Graybill
       1992, sec. 3.4): no exact interval exists; its coverage is close to
-      nominal (tested);
+      nominal (tested at 8 geometries, ICC 1/3, balanced and not);
     - the ICC sigma_b^2 / (sigma_b^2 + sigma_w^2) and its interval from
       F = MS_b / MS_w, exact when balanced (Searle 1971).
 
@@ -351,7 +351,8 @@ def meta_regression(estimates: ArrayLike, sems: ArrayLike, x: ArrayLike | None =
     coefficients is Knapp-Hartung's (``test="t"``): their covariance
     (X'WX)^-1 scaled by sum w_i r_i^2 / (K - p) and Student-t with K - p
     dof, which allows for the error of tau^2 and keeps its level with few
-    sizes (tested); ``"z"`` takes (X'WX)^-1 as exact and the normal law.
+    sizes (tested with 7); ``"z"`` takes (X'WX)^-1 as exact and the normal
+    law.
     With equal s_i and ``test="t"`` the fit is ordinary least squares, its
     errors included.
 
@@ -557,11 +558,12 @@ def minimum_detectable_effect(sem: float, dof: float, *, alpha: float = 0.05, po
 
     MDE = (t_{1-alpha/2, dof} + t_{power, dof}) sem: the effect whose
     estimate exceeds the test's threshold t_{1-alpha/2} sem with
-    probability ``power`` (the far tail neglected, and the error of sem:
-    the exact noncentral-t power is within 0.02 of ``power`` from 9 dof on,
-    tested). To be written beside every "not resolved": it says what the
-    measurement could have missed, which mean + t sem does not (that bound
-    shrinks when the estimate happens to be negative).
+    probability ``power`` (the far tail and the error of sem neglected:
+    at alpha 0.05 and power 0.8 the exact noncentral-t power is 0.77 on 2
+    dof and within 0.02 of 0.8 from 3 dof on, tested). To be written
+    beside every "not resolved": it says what the measurement could have
+    missed, which mean + t sem does not (that bound shrinks when the
+    estimate happens to be negative).
 
     Parameters
     ----------
