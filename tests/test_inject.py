@@ -97,6 +97,21 @@ def test_an_injection_never_changes_the_run(scene, select, tmp_path):
                               plain["tilt_first_slip"].values[:, 1:])
 
 
+@pytest.mark.parametrize("scene", ["chain-overshoot-0", "irregular-min_slips-repeats"])
+def test_twins_that_outgrow_the_draw_buffers_read_the_same_draws(scene, tmp_path):
+    # With 7 draws per buffer the twins and the plain tests run out again and again: the buffers grow under
+    # them (Streams.extend_tilt), and the results are those of the default batch, twins and all.
+    cfg = _with_inject(_scene_config(scene, tmp_path), c=0.05, select=0.5)
+    small = slidernet.run({**cfg, "solver": {"batch": 7}})
+    default = slidernet.run(cfg)
+    assert set(small.data_vars) == set(default.data_vars)
+    for name in default.data_vars:
+        np.testing.assert_array_equal(small[name].values, default[name].values, err_msg=name)
+    plain = slidernet.run({**_scene_config(scene, tmp_path), "solver": {"batch": 7}})
+    for name in plain.data_vars:
+        np.testing.assert_array_equal(small[name].values, plain[name].values, err_msg=name)
+
+
 def test_the_pair_runs_on_the_csr_kernel_for_the_ages_with_the_pair_kernels_bits(tmp_path):
     # select < 1 reads each contact's age: the two sliders then run on csr, whose bits are the pair kernel's
     # (ARCHITECTURE.md, invariant 6).

@@ -316,7 +316,8 @@ class Scene:
             tilt_min_slips=tilt.min_slips,
             tilt_min_shift=min_shift,
             tilt_repeats=tilt.repeats if tilt_at == "records" else 1,
-            inject=tilt.inject if tilt_at == "records" else None,
+            # Where a test it raises runs (Config.injected_tests, the one rule).
+            inject=tilt.inject if tilt_at == "records" and cfg.injected_tests() else None,
             operators=operators,
         )
 
