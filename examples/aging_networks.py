@@ -133,6 +133,14 @@ class Group:
         ``records`` (the study's estimator), or ``rearrangements`` for the
         pair: the paper's own estimator, the appendix's test before every
         rearrangement, as a check of the study's on the pair.
+    inject : (c, select) or None
+        ``[tilt] inject``: a known aging c ln(1 + t / tau_th) of the tested
+        copy's thresholds (all, or the ``select`` share of the oldest
+        contacts), the positive control of ``examples/aging_recovery.py``.
+    realizations : int or None
+        Realizations per size, over all geometries (None: the preset's).
+    observables : tuple of str
+        Observables beside the base configuration's.
     """
 
     name: str
@@ -143,6 +151,9 @@ class Group:
     overshoot: float = 1.0
     tilt: tuple[tuple[str, float], ...] = ()
     mu_eff_at: str = "records"
+    inject: tuple[float, float] | None = None
+    realizations: int | None = None
+    observables: tuple[str, ...] = ()
 
     def rule(self) -> str:
         """The slip and sliding rule in words (the JSON's and the figure's label)."""
@@ -225,7 +236,7 @@ def point_config(group: Group, params: str, size: int, geometry: int, preset: Pr
     ntilde = cfg["network"]["Ntilde"]
     # Independent ensembles: a seed per parameter set and per geometry (the sizes of one sweep share it).
     cfg["seed"] = 1 + 1000 * list(PARAMS).index(params) + geometry
-    cfg["realizations"] = preset.realizations // group.geometries
+    cfg["realizations"] = (group.realizations or preset.realizations) // group.geometries
     cfg["steps"] = preset.steps
     cfg["log_points_per_decade"] = preset.per_decade
     network: dict[str, Any] = {"kind": "chain" if group.kind == "pair" else group.kind, "Ntilde": ntilde}
@@ -241,6 +252,10 @@ def point_config(group: Group, params: str, size: int, geometry: int, preset: Pr
         cfg["friction"]["overshoot"] = group.overshoot
     if group.tilt:
         cfg["tilt"] = dict(group.tilt)
+    if group.inject is not None:
+        c, select = group.inject
+        cfg["tilt"] = {**cfg.get("tilt", {}), "inject": {"c": c, "t0": 1.0, "select": select}}
+    cfg["observables"] = [*cfg["observables"], *(o for o in group.observables if o not in cfg["observables"])]
     if group.mu_eff_at != "records":
         cfg["mu_eff_at"] = group.mu_eff_at
         cfg["observables"] = [o for o in cfg["observables"] if o != "tilt_loads"]  # a network tilt test's

@@ -48,7 +48,9 @@ def run_quick_study(name: str, out: Path) -> tuple[ModuleType, dict]:
 
 
 @pytest.mark.parametrize(
-    "name", ["creep_irregular", "chain_aging", "aging_networks", "creep_networks", "rejuvenation"], ids=str)
+    "name",
+    ["creep_irregular", "chain_aging", "aging_networks", "aging_recovery", "creep_networks", "rejuvenation"],
+    ids=str)
 def test_help_names_the_options(name, capsys):
     module = load_example(name)
     with pytest.raises(SystemExit) as exc:
@@ -132,6 +134,33 @@ def test_incline_creep_quick(tmp_path):
         below = np.asarray(b["A_over_Ntilde"]) < b["A_c"][n]
         assert below.any() and (~below).any()
         assert (v[below] == 0).all() and (v[~below] > 0).all()
+
+
+def test_aging_recovery_quick(tmp_path):
+    """The positive control's --quick preset (the pair and irregular 16, both injections; ~10 s): every
+    estimator's recovery with an error, and the one recovery that is exact."""
+    study, data = run_quick_study("aging_recovery", tmp_path)
+    assert len(data["points"]) == sum(len(g.sizes) for g in study.PRESETS["quick"].groups)
+    for p in data["points"]:
+        assert p["configs"][0]["tilt"]["inject"] == {"c": study.INJECT_C, "t0": 1.0, "select": p["select"]}
+        rec = p["recovery"]
+        assert rec["raised"] == math.ceil(p["select"] * p["N"])
+        for name in study.ESTIMATORS:
+            for window in study.WINDOWS:
+                for norm in ("contact", "mean"):
+                    r = rec[f"{name}|{window}|{norm}"]
+                    assert math.isfinite(r["recovery"]) and r["sem"] >= 0
+                    assert r["pairs"] == p["realizations"]
+                    assert r["dof"] == (p["geometries"] - 1 if p["kind"] == "irregular" else p["realizations"] - 1)
+        # Against the mean shift, the recovery is 1/q times that against the per-contact shift.
+        assert math.isclose(rec["mu_eff|10-1e3|mean"]["recovery"] * rec["share"],
+                            rec["mu_eff|10-1e3|contact"]["recovery"], rel_tol=1e-12)
+    (pair,) = [p for p in data["points"] if p["kind"] == "pair" and p["select"] == 1.0]
+    # Along a chain the first slip of the tilt test is at the load min_i (mu_s,i - f_i / N_i): every threshold
+    # raised by one shift raises it by that shift, test by test, so its recovery is 1 up to rounding.
+    for window in study.WINDOWS:
+        r = pair["recovery"][f"tilt_first_slip|{window}|contact"]
+        assert r["recovery"] == pytest.approx(1.0, abs=1e-9) and r["sem"] < 1e-9
 
 
 def test_aging_networks_quick(tmp_path):
