@@ -257,3 +257,41 @@ def test_recompute_forces_on_the_pair_kernel_has_nothing_to_reset() -> None:
     np.testing.assert_array_equal(real.forces(), forces, strict=True)
     real.advance()
     assert real.n > n
+
+
+# -- the exactly integrated 2D slip refills often, so that a stop request is seen -------------------
+
+
+def _exact_2d(**extra: Any) -> dict[str, Any]:
+    return make_config(**{"network": {"kind": "irregular", "n": 16, "seed": 0, "Ntilde": 1e-7},
+                          "driver.sigma_theta": 3e-7, "steps": 12, "solver.slip": "exact", **extra})
+
+
+def test_an_exact_2d_scene_polls_a_stop_request_within_exact_slip_batch_slips() -> None:
+    # A case of the configuration fuzz (a 4 x 4 lattice, slip = "exact", sigma_theta / Ntilde = 1e7): the
+    # kernel returned to Python every 65 536 slips (solver.batch), each slip taking up to tenths of a second,
+    # and one SIGTERM did not stop the run for minutes.
+    from slidernet.solver.scene import EXACT_SLIP_BATCH
+
+    scene = Scene.from_config(load_config(_exact_2d()))
+    real = Realization(scene, np.random.SeedSequence(3))
+    polls: list[int] = []
+
+    def stop() -> bool:
+        polls.append(real.n)
+        return False
+
+    real.advance(stop=stop)
+    gaps = np.diff([0, *polls, real.n])
+    assert scene.batch == EXACT_SLIP_BATCH == 32
+    assert real.n > 10 * EXACT_SLIP_BATCH and gaps.max() <= EXACT_SLIP_BATCH
+    # The straight slip keeps the batch the configuration asks for.
+    assert Scene.from_config(load_config(_exact_2d(**{"solver.slip": "straight"}))).batch == 65_536
+
+
+def test_the_exact_2d_cap_of_the_batch_changes_no_bit() -> None:
+    a = simulate(Scene.from_config(load_config(_exact_2d())), np.random.SeedSequence(5))
+    b = simulate(Scene.from_config(load_config(_exact_2d(**{"solver.batch": 7}))), np.random.SeedSequence(5))
+    assert a.keys() == b.keys()
+    for key in a:
+        np.testing.assert_array_equal(a[key], b[key], strict=True, err_msg=key)

@@ -34,7 +34,8 @@ class SolverConfig(_Strict):
         100_000_000, description="Slips after which an avalanche that has not ended stops the run with an "
                                  "AvalancheError.")
     batch: Annotated[Integer, Field(ge=1)] = Field(
-        1 << 16, description="Random draws that wait in the kernels' buffers; never changes a result.")
+        1 << 16, description="Random draws that wait in the kernels' buffers; never changes a result. A stop "
+                             "request is seen at every refill: with slip = 'exact' in 2D at most 32 wait.")
     recompute_every: Annotated[Integer, Field(ge=0)] = Field(
         10_000_000, description="Slips between two resets of the forces from the displacements (0: never).")
     slip: Literal["straight", "exact"] = Field(
