@@ -38,6 +38,11 @@ ATTRS = {
                                  "evolution (since t = 0 for a node that has not slipped)", "units": "tau_th"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
                                         "(NaN: none)", "units": "1"},
+    "mu_shs": {"long_name": "static friction from the slide-hold-slide pull at t: peak of the stage force per "
+                            "unit normal load, plus f_bar, until every contact was renewed (NaN: no pull, the "
+                            "network had slid away)", "units": "1"},
+    "shs_travel": {"long_name": "travel of the slide-hold-slide stage from the start of its pull at t to the peak "
+                                "of mu_shs", "units": "l0"},
     "tilt_capped": {"long_name": "number of network tilt tests at t, over the realizations, that met the "
                                 "avalanche cap (a part of the network sliding alone) before the sliding rule of "
                                 "[tilt]: left out of mu_eff and mu_eff_count", "units": "1"},
@@ -177,7 +182,7 @@ def realization_variables(records: list[Record], observables: list[str], first_r
         with np.errstate(invalid="ignore", divide="ignore"):
             value = np.stack([r["f_sum"] for r in records]) / np.where(count > 0, count, np.nan)
         out["mu_eff_realization"] = (("realization", "t"), value, ATTRS["mu_eff_realization"])
-    for name in ("tilt_first_slip", "tilt_all_moving"):
+    for name in ("tilt_first_slip", "tilt_all_moving", "mu_shs", "shs_travel"):
         if name in records[0]:
             out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
     _network_variables(out, records, first_realization)
@@ -224,7 +229,7 @@ class EnsembleStats:
         The last recorded time, for the rate ``r = n(steps) / steps``.
     """
 
-    MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age")
+    MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age", "mu_shs")
 
     def __init__(self, observables: list[str], steps: int) -> None:
         self.observables = list(observables)

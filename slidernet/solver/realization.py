@@ -2,7 +2,7 @@
 
 Data flow for one realization (see ARCHITECTURE.md)::
 
-    SeedSequence child r --spawn(3)--> [driver, thresholds, tilt]; tilt --spawn(1)--> [tilt_uniforms]
+    SeedSequence child r --spawn(4)--> [driver, thresholds, tilt, shs]; tilt --spawn(1)--> [tilt_uniforms]
     driver.thetas(rng_driver, steps)      -> theta(t_q), q = 0..steps
     TruncatedStream(dist, rng_thresholds) -> initial mu_s, then one per slip, handed out in batches
     kernel (pair, csr or vec)             -> records at the recorded times
@@ -38,6 +38,7 @@ _REBUILT = {
     "series": "the kernels' view of out: the same arrays, restored in place",
     "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
     "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
+    "_shs_work": "scratch arrays of the slide-hold-slide pull, reset by every pull",
 }
 
 #: A stop request, polled where a kernel returns to refill a buffer: True asks the realization to stop there.
@@ -53,7 +54,7 @@ class Realization:
 
     Every value drawn is a function of ``seed_seq`` alone, never of
     ``solver.batch`` (which only sets how many values wait in the kernels'
-    buffers) nor of where the kernels stop. The four streams of
+    buffers) nor of where the kernels stop. The five streams of
     :func:`realization_streams` are read in this order:
 
     1. ``driver``: ``driver.thetas(rng, steps)``, once.
@@ -70,6 +71,9 @@ class Realization:
     4. ``tilt_uniforms``: ``rng.random()``, one value per creep branch of a
        tilt test (the uniform force of the appendix), in the order the tests
        read them.
+    5. ``shs``: a third ``TruncatedStream`` (``draws["shs"]``): the
+       thresholds the slide-hold-slide pulls redraw, one per slip but the
+       last of each pull, in the order the pulls read them.
 
     The tilt test reads thresholds and uniforms in proportions that depend
     on the state, so each kind has its own stream; buffers of either may be
@@ -104,8 +108,12 @@ class Realization:
             self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
         if scene.counts_capped:
             self.out["tilt_capped"] = np.zeros(T, np.int64)
-        self._tilted = 0  # recorded times whose network tilt test is done
+        if scene.shs_stiffness is not None:
+            # NaN where no pull was made: the recorded times after the network slid away.
+            self.out.update(mu_shs=np.full(T, np.nan), shs_travel=np.full(T, np.nan))
+        self._tilted = 0  # recorded times whose network tilt test (and slide-hold-slide pull) is done
         self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._shs_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
         self.state["theta"] = self.thetas[0]
         self.state["u"] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
@@ -120,17 +128,18 @@ class Realization:
 
     @property
     def rngs(self) -> dict[str, np.random.Generator]:
-        """The realization's Generators by name (``driver``, ``thresholds``, ``tilt``, ``tilt_uniforms``)."""
+        """The realization's Generators by name (``driver``, ``thresholds``, ``tilt``, ``tilt_uniforms``,
+        ``shs``)."""
         return self.streams.rngs
 
     @property
     def draws(self) -> dict[str, TruncatedStream]:
-        """The truncated threshold streams by name (``thresholds``, ``tilt``)."""
+        """The truncated threshold streams by name (``thresholds``, ``tilt``, ``shs``)."""
         return self.streams.truncated
 
     @property
     def buffers(self) -> kernels.Draws:
-        """The draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``)."""
+        """The draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``, ``shs_mu``)."""
         return self.streams.buffers
 
     def recompute_forces(self) -> float:
@@ -185,7 +194,8 @@ class Realization:
         """Run the thermal steps up to ``to_step`` (default: the last one).
 
         With ``mu_eff_at = "records"`` the network tilt test is made on the
-        state at every recorded time passed on the way.
+        state at every recorded time passed on the way, and with the
+        observable ``mu_shs`` the slide-hold-slide pull (:meth:`shs_test`).
 
         Parameters
         ----------
@@ -205,13 +215,16 @@ class Realization:
         to_step = scene.steps if to_step is None else int(to_step)
         if not self.step <= to_step <= scene.steps:
             raise ValueError(f"to_step must lie in [{self.step}, {scene.steps}]; got {to_step}")
-        if scene.tilt_at == "records":
+        if scene.tilt_at == "records" or scene.shs_stiffness is not None:
             while self._tilted < scene.out_steps.size and scene.out_steps[self._tilted] <= to_step:
                 if not self._run_kernel(int(scene.out_steps[self._tilted]), stop):
                     return self  # stopped before the recorded time: no tilt test of a state in between
                 if self.slid_away:
                     return self  # no tilt test of a sliding network: mu_eff_count stays 0 from here on
-                self._tilt_record(self._tilted)
+                if scene.tilt_at == "records":
+                    self._tilt_record(self._tilted)
+                if scene.shs_stiffness is not None:
+                    self._shs_record(self._tilted)
                 self._tilted += 1
         self._run_kernel(to_step, stop)
         return self
@@ -236,13 +249,7 @@ class Realization:
         scene = self.scene
         o = scene.tilt_operators()
         N = scene.network.n_nodes
-        if self._tilt_work is None:
-            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N, np.int64),
-                               np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS))
-        heaps, epoch, count, pos, loads = self._tilt_work
-        F = self.forces().reshape(N, -1)
-        G = np.zeros((N, 2))
-        G[:, : F.shape[1]] = F
+        (heaps, epoch, count, pos, loads), G = self._test_work("_tilt_work")
         mu = self.mu.copy()
         st = self.state
         pos[:] = 0
@@ -262,6 +269,67 @@ class Realization:
             # The test stands where it ran out: longer buffers, and it goes on from there.
             pos[tilt_net.P_MU], pos[tilt_net.P_U] = self.streams.extend_tilt(
                 st, (int(pos[tilt_net.P_MU]), int(pos[tilt_net.P_U])))
+
+    def _test_work(self, name: str) -> tuple[tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+                                             np.ndarray]:
+        """What a test on a copy of the state starts from: its scratch arrays (the attribute ``name``, made on
+        first use: heaps, epoch, count, pos, loads) and the forces G, shape (N, 2), 1D padded with zeros."""
+        from slidernet.kernels import tilt_net
+
+        N = self.scene.network.n_nodes
+        if getattr(self, name) is None:
+            setattr(self, name, (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N, np.int64),
+                                 np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS)))
+        F = self.forces().reshape(N, -1)
+        G = np.zeros((N, 2))
+        G[:, : F.shape[1]] = F
+        return getattr(self, name), G
+
+    def shs_test(self) -> tuple[float, float]:
+        """One slide-hold-slide pull on a copy of the current state: mu_shs, and the stage's travel at the peak.
+
+        A stage moving quasi-statically along +x pulls every node i through a
+        spring of stiffness gamma N_i <k> (``[shs] stiffness`` = gamma, <k> the
+        mean spring stiffness) until every node has slipped at least once; the
+        sample is the peak of the stage force per unit normal load, plus the
+        mean f_ext along x (docs/model.md, "Slide-hold-slide";
+        :mod:`slidernet.kernels.tilt_net` for the rule). The state is left as it
+        was; the draws come from the realization's ``shs`` stream.
+
+        Returns
+        -------
+        mu_shs : float
+            The peak load per unit normal load.
+        travel : float
+            The stage's travel X from the start of the pull to that peak, in l0.
+        """
+        from slidernet.kernels import tilt_net
+
+        scene = self.scene
+        o = scene.shs_operators()
+        (heaps, epoch, count, pos, loads), G = self._test_work("_shs_work")
+        mu = self.mu.copy()  # the thresholds the pull starts from: the contacts as the hold left them
+        st = self.state
+        pos[:] = 0
+        pos[tilt_net.P_MU] = st["shs_mu_pos"][0]
+        settings = scene.settings()
+        while True:
+            end = o.test(G, mu, o.f_ext, o.f_bar, o.net, settings, self.buffers.shs_mu, pos, heaps, epoch, count,
+                         loads, o.pull)
+            status = kernels.tilt_status(end)
+            if status == kernels.DONE:
+                st["shs_mu_pos"] = pos[tilt_net.P_MU]
+                return float(loads[tilt_net.L_PEAK]), float(loads[tilt_net.L_TRAVEL] * scene.network.Ntilde)
+            if status != kernels.NEED_TILT:
+                slips = int(pos[tilt_net.N_SLIPS])
+                why = (f"it reached solver.max_avalanche = {scene.max_avalanche} slips in all. A genuinely long "
+                       "pull needs a larger solver.max_avalanche." if pos[tilt_net.STOP] == tilt_net.STOP_SLIPS
+                       else "a slip of the exactly integrated 2D motion (solver.slip = 'exact') did not come to "
+                            "rest within its step budget.")
+                raise TiltTestError(f"The slide-hold-slide pull did not renew every contact at step {self.step}: "
+                                    f"after {slips} slips, " + why)
+            # The pull stands where it ran out: a longer buffer, and it goes on from there.
+            pos[tilt_net.P_MU] = self.streams.extend_shs(st, int(pos[tilt_net.P_MU]))
 
     def _tilt_stop_reason(self, pos: np.ndarray, load: float, cap: int) -> str:
         """The message of a network tilt test that gave up (``pos[STOP]`` of the kernel says why)."""
@@ -305,6 +373,9 @@ class Realization:
             loads = self._tilt_work[4]
             self.out["tilt_first_slip"][k] = loads[L_FIRST]
             self.out["tilt_all_moving"][k] = loads[L_MOVING]
+
+    def _shs_record(self, k: int) -> None:
+        self.out["mu_shs"][k], self.out["shs_travel"][k] = self.shs_test()
 
     def _run_kernel(self, to_step: int, stop: StopCheck | None) -> bool:
         """Run the kernel to ``to_step``; False if ``stop`` asked it to stop first (see :meth:`advance`)."""
@@ -447,6 +518,8 @@ class Realization:
             (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
             record bin, shape (T,) (under a stricter sliding rule, ``tilt_capped``:
             the tests that met the avalanche cap first, which these leave out),
+            with ``mu_shs`` its pull's peak and the stage's travel there (l0),
+            ``mu_shs`` and ``shs_travel`` (NaN after the network slid away),
             and the scalar ``n_events``; where the
             scene can slide away (``scene.records_slide``), the scalar
             ``slid_away_at`` (tau_th; NaN if it did not); the backend's
