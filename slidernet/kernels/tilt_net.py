@@ -322,7 +322,8 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         moving = pos[S_MOVING]
         done = pos[S_DONE]
         av_slips = pos[S_AV]
-        renewed = pos[S_RENEWED]
+        # Read only by a pull: in the tilt test's variants renewed stays the constant 0, no register held for it.
+        renewed = pos[S_RENEWED] if pull > 0.0 else 0
     pos[STOP] = 0
     while True:
         # What the last slip left to do, each step first checking that its draws are there:
