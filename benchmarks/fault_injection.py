@@ -320,8 +320,8 @@ def fault_shared_folder(folder: Path, config: Path, reference: Path) -> tuple[bo
 
 HANG_PLUGIN = """\"\"\"gaussian_steps, whose realizations never return once a file HANG is in the folder.
 
-The checks before the run draw 2**16 values and the kernels' probe 2: only a realization asks for the run's
-own steps (20 000).
+The checks before the run draw from the driver in the main process; the realizations run in the workers
+(--workers 2, forked: they inherit MAIN, the process that imported this file first).
 \"\"\"
 import os
 import time
@@ -329,10 +329,12 @@ import time
 import slidernet
 from slidernet.plugins.drivers import GaussianSteps
 
+MAIN = os.getpid()
+
 
 class MaybeHanging(GaussianSteps):
     def thetas(self, rng, steps):
-        if os.path.exists("HANG") and steps == 20000:
+        if os.path.exists("HANG") and os.getpid() != MAIN:
             open(f"hanging-{os.getpid()}", "w").close()
             while True:
                 time.sleep(3600)
@@ -379,7 +381,7 @@ def fault_hanging_plugin(folder: Path, config: Path, group: bool) -> tuple[bool,
     if proc.returncode != 128 + signal.SIGTERM or bad:
         return False, f"SIGTERM gave rc {proc.returncode}: {bad or err.strip()[-600:]}"
     (work / "HANG").unlink()
-    again = start_here("hung", resume=True)
+    again = start_here("hung", resume=has_run(work / "hung"))
     _, err = again.communicate(timeout=600)
     if again.returncode != 0:
         return False, f"the resume failed (rc {again.returncode}): {err.strip()[-600:]}"

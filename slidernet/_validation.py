@@ -41,6 +41,7 @@ _TESTS: dict[str, Callable[[Any], Any]] = {
     "!= 0": lambda x: x != 0,
     ">= 1": lambda x: x >= 1,
     "> 1": lambda x: x > 1,
+    "in (0, 1)": lambda x: (x > 0) & (x < 1),   # a probability: a confidence, a level, a power
 }
 
 
@@ -79,7 +80,7 @@ def check_scalar(value: object, param: str, owner: str, requirement: str = "fini
     param, owner : str
         The parameter's name and who owns it (a plugin's registered name,
         ``units``, a theory function), for the message.
-    requirement : {"finite", "> 0", ">= 0", "!= 0", ">= 1", "> 1"}
+    requirement : {"finite", "> 0", ">= 0", "!= 0", ">= 1", "> 1", "in (0, 1)"}
         What the value must satisfy beyond being finite.
 
     Returns

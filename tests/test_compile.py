@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 import slidernet
@@ -177,3 +178,18 @@ def test_the_probe_is_small_and_keeps_the_kernel():
     assert probe.friction.static.name == big.friction.static.name == "gaussian"
     lattice = load_config(_scene_config({"network": {"kind": "triangular", "shape": [1, 900], "Ntilde": 1e-7}}))
     assert probe_config(lattice).network.shape == (1, 4)
+
+
+def test_the_probe_drives_gently_whatever_the_runs_sigma_theta():
+    # sigma_theta = 1 at Ntilde = 1e-7 (a unit slip: 1 K meant) made the probe's two steps of a 4 x 4 lattice
+    # take ~1e8 slips in one kernel call, before the run's signal handling: one SIGTERM did not stop it for
+    # 30 s (benchmarks/config_fuzz.py, case 284 of seed 0).
+    wild = load_config(_scene_config({"network": {"kind": "triangular", "shape": [4, 4], "Ntilde": 1e-7},
+                                      "driver": {"name": "gaussian_steps", "sigma_theta": 1.0}}))
+    probe = probe_config(wild)
+    thetas = probe.driver_plugin().thetas(np.random.default_rng(0), 2)
+    assert np.abs(thetas).max() <= probe.network.Ntilde
+    assert probe.driver.name == "gaussian_steps" and probe.network.shape == (4, 4)
+    compile_kernels(wild, notice=None)  # two steps of a few slips (it ran for minutes)
+    gentle = load_config(_scene_config({}))
+    assert probe_config(gentle).network.Ntilde == gentle.network.Ntilde  # the usual case is left alone

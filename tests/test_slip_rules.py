@@ -21,6 +21,8 @@ from slidernet.config import load_config
 from slidernet.errors import ConfigError
 from slidernet.kernels.plane import straight_slip
 from slidernet.kernels.tilt_net import L_MOVING, N_LOADS, N_POS
+from slidernet.model.builders import irregular
+from slidernet.model.network import Network
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver import Realization, Scene
 from slidernet.solver.scene import tilt_avalanche_cap
@@ -165,6 +167,31 @@ def test_the_rule_can_raise_the_load_where_a_motion_above_mu_d_can_stop(seed):
     base, _ = _test_on(real, 1, 0.0, tilt_mu, tilt_u)
     stricter, _ = _test_on(real, 2, 0.0, tilt_mu, tilt_u)
     assert stricter > base + 1e-3
+
+
+def test_min_displacement_counts_reference_slips_of_the_mean_spring():
+    # min_displacement = X asks for X reference slips ell = (1 + e)(<mu_s> - mu_d) <N_i> / <k>, in Ntilde l0
+    # (docs/model.md): the slip of one slider held by one spring of the mean stiffness, not a node's own
+    # stiffness K_ii,xx, which the configuration reference once named and which a Delaunay network makes
+    # several times <k>. Springs and normal loads differ here, so that no other mean gives the same length.
+    rng = np.random.default_rng(7)
+    shape = irregular(12, 1e-7, np.random.default_rng(3))
+    k = rng.uniform(0.5, 3.0, shape.n_edges)
+    normal_load = rng.uniform(0.5, 2.0, shape.n_nodes)
+    net = Network(shape.positions, shape.edges, 1e-7, k=k, normal_load=normal_load)
+    e, X, mu_s_mean = 0.5, 4.0, 0.65  # the uniform law on [0.55, 0.75], all above mu_d = 0.5
+    cfg = make_config(mu_eff_at="records", network={"kind": "irregular", "n": 12, "Ntilde": 1e-7},
+                      tilt={"min_displacement": X}, **{"friction.overshoot": e,
+                                                      "friction.static": {"name": "uniform", "low": 0.55,
+                                                                          "high": 0.75}})
+    scene = Scene.from_config(load_config(cfg), network=net)
+    by_hand = X * (1 + e) * (mu_s_mean - MU_D) * normal_load.mean() / k.mean()
+    assert scene.tilt_min_shift == pytest.approx(by_hand, rel=1e-9)
+    # The test tells the two apart: K_ii,xx = sum over i's springs of k cos^2 of the spring's angle to x.
+    d = shape.positions[shape.edges[:, 1]] - shape.positions[shape.edges[:, 0]]
+    k_xx = k * d[:, 0] ** 2 / (d ** 2).sum(axis=1)
+    K_xx = np.bincount(shape.edges.ravel(), weights=np.repeat(k_xx, 2), minlength=shape.n_nodes)
+    assert K_xx.mean() > 1.5 * k.mean()
 
 
 # --------------------------------------------------------------------------

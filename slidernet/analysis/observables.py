@@ -10,7 +10,10 @@ mu_eff(t_k) pools every tilt test made at the rearrangements of the bin
 t = 0 holds one test per realization, made on the initial state, so that
 mu_eff(0) is the value of a fresh system. A bin without any rearrangement
 gives NaN, with ``mu_eff_count = 0``. Its standard error treats the
-realizations as independent clusters of correlated samples.
+realizations as independent clusters of correlated samples: the tests of
+one realization (the rearrangements of a bin, or the ``[tilt] repeats``
+tests of one state) are never counted as independent. ``mu_eff_injected``,
+the injected twins of ``[tilt] inject``, is pooled by the same rule.
 """
 
 from __future__ import annotations
@@ -31,9 +34,12 @@ ATTRS = {
     "mu_eff": {"long_name": "effective static friction coefficient from the virtual tilt test",
                "units": "1"},
     "tilt_first_slip": {"long_name": "load per unit normal load along x, f + f_bar, at the first slip of the "
-                                     "network tilt test at t", "units": "1"},
+                                     "network tilt test at t (the mean over its [tilt] repeats)", "units": "1"},
     "tilt_all_moving": {"long_name": "load f + f_bar at which an avalanche of the tilt test at t first set every "
-                                     "node in motion at once, above mu_d or not (NaN: none did)", "units": "1"},
+                                     "node in motion at once, above mu_d or not (the mean over the [tilt] repeats "
+                                     "in which one did; NaN: none did)", "units": "1"},
+    "mu_eff_spread": {"long_name": "standard deviation (ddof = 1) of the realization's [tilt] repeats network "
+                                   "tilt tests at t (NaN: fewer than 2 sampled)", "units": "1"},
     "contact_age": {"long_name": "mean over the nodes of the time since each node last slipped in the horizontal "
                                  "evolution (since t = 0 for a node that has not slipped)", "units": "tau_th"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
@@ -47,6 +53,19 @@ ATTRS = {
                                 "avalanche cap (a part of the network sliding alone) before the sliding rule of "
                                 "[tilt]: left out of mu_eff and mu_eff_count", "units": "1"},
 }
+
+#: The pairing every injected variable rests on, in its attributes with the injection's c, t0 and select.
+PAIRING = ("each test at t is made twice, on the same state with the same draws of the tilt stream: as it is "
+           "(the plain variable) and on a copy whose thresholds mu_s are raised by "
+           "inject_c ln(1 + t / inject_t0), those of the ceil(inject_select N) oldest contacts (all with "
+           "inject_select = 1); a contact that slips in the test draws a fresh threshold without the rise")
+
+
+def _injected_attrs(name: str, inject: np.ndarray) -> dict[str, str | float]:
+    """The attributes of the injected twin of ``name``: its plain meaning, the injection and the pairing."""
+    c, t0, select = (float(x) for x in inject)
+    return {**ATTRS[name], "long_name": f"injected twin ([tilt] inject) of: {ATTRS[name]['long_name']}",
+            "inject_c": c, "inject_t0": t0, "inject_select": select, "pairing": PAIRING}
 
 
 Record = dict[str, np.ndarray]
@@ -175,16 +194,23 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     for name in ("n", "mu_max", "x_G", "n_records", "contact_age"):
         if name in observables:
             out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
-    if "mu_eff_realization" in observables:
-        # Each realization's own mean of its tilt tests in the bin: independent across realizations,
-        # so trends and errors of mu_eff can come from the spread of realizations, not of time bins.
-        count = np.stack([r["f_count"] for r in records]).astype(np.float64)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            value = np.stack([r["f_sum"] for r in records]) / np.where(count > 0, count, np.nan)
-        out["mu_eff_realization"] = (("realization", "t"), value, ATTRS["mu_eff_realization"])
-    for name in ("tilt_first_slip", "tilt_all_moving", "mu_shs", "shs_travel"):
-        if name in records[0]:
-            out[name] = (("realization", "t"), np.stack([r[name] for r in records]), ATTRS[name])
+    inject = records[0].get("inject")
+    for suffix in ("", "_injected") if inject is not None else ("",):
+        attrs = (lambda name: ATTRS[name]) if not suffix else (lambda name: _injected_attrs(name, inject))
+        if "mu_eff_realization" in observables:
+            # Each realization's own mean of its tilt tests in the bin: independent across realizations,
+            # so trends and errors of mu_eff can come from the spread of realizations, not of time bins.
+            count = np.stack([r["f_count" + suffix] for r in records]).astype(np.float64)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                value = np.stack([r["f_sum" + suffix] for r in records]) / np.where(count > 0, count, np.nan)
+            out[f"mu_eff{suffix}_realization"] = (("realization", "t"), value, attrs("mu_eff_realization"))
+        for name in ("tilt_first_slip", "tilt_all_moving", "mu_shs", "shs_travel"):
+            if name + suffix in records[0]:
+                out[name + suffix] = (("realization", "t"), np.stack([r[name + suffix] for r in records]),
+                                      attrs(name))
+    if "mu_eff_spread" in records[0]:
+        out["mu_eff_spread"] = (("realization", "t"), np.stack([r["mu_eff_spread"] for r in records]),
+                                ATTRS["mu_eff_spread"])
     _network_variables(out, records, first_realization)
     if "creep_events" in records[0]:
         _creep_variables(out, records)
@@ -236,9 +262,11 @@ class EnsembleStats:
         self.steps = steps
         self.R = 0
         self._moments: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # name -> (mean, M2)
-        self._f: dict[str, np.ndarray] = {}
+        self._f: dict[str, dict[str, np.ndarray]] = {}  # "" or "_injected" -> the pooled sums of the tilt tests
         self._age_count: np.ndarray | None = None  # (T, bins) int64: the nodes' ages, summed over realizations
-        self._capped: np.ndarray | None = None  # (T,) int64: the tilt tests that met the cap first, summed
+        # "" or "_injected" -> (T,) int64: the tilt tests that met the cap first, summed
+        self._capped: dict[str, np.ndarray] = {}
+        self._inject: np.ndarray | None = None  # the injection's (c, t0, select), where [tilt] inject is set
 
     def _merge(self, name: str, x: np.ndarray) -> None:
         """Fold the chunk ``x`` (B, ...) into the running (mean, M2) of ``name``."""
@@ -270,26 +298,31 @@ class EnsembleStats:
         for name in ("v_creep", "v_creep_cycle"):
             if name in records[0]:
                 self._merge(name, np.array([[r[name]] for r in records], dtype=np.float64))
-        if "tilt_capped" in records[0]:
-            capped = np.stack([r["tilt_capped"] for r in records]).sum(axis=0)
-            self._capped = capped if self._capped is None else self._capped + capped
-        if "mu_eff" in self.observables:
-            fsum = np.stack([r["f_sum"] for r in records])
-            count = np.stack([r["f_count"] for r in records]).astype(float)
-            if not self._f:
-                # Shift for the sums of squares: the first chunk's pooled value,
-                # close to the final one, so that no digits cancel.
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    shift = fsum.sum(axis=0) / count.sum(axis=0)
-                self._f = {"shift": np.nan_to_num(shift), "f": 0.0, "c": 0.0, "gg": 0.0, "gc": 0.0, "cc": 0.0}
-            g = fsum - self._f["shift"] * count
-            f = self._f
-            f["f"] = f["f"] + fsum.sum(axis=0)
-            f["c"] = f["c"] + count.sum(axis=0)
-            f["gg"] = f["gg"] + (g * g).sum(axis=0)
-            f["gc"] = f["gc"] + (g * count).sum(axis=0)
-            f["cc"] = f["cc"] + (count * count).sum(axis=0)
+        self._inject = records[0].get("inject")
+        for suffix in ("", "_injected"):
+            if "tilt_capped" + suffix in records[0]:
+                capped = np.stack([r["tilt_capped" + suffix] for r in records]).sum(axis=0)
+                self._capped[suffix] = capped + self._capped.get(suffix, 0)
+            if "mu_eff" in self.observables and "f_sum" + suffix in records[0]:
+                self._pool(suffix, np.stack([r["f_sum" + suffix] for r in records]),
+                           np.stack([r["f_count" + suffix] for r in records]).astype(float))
         self.R += len(records)
+
+    def _pool(self, suffix: str, fsum: np.ndarray, count: np.ndarray) -> None:
+        """Fold a chunk's tilt-test sums (B, T) and counts (B, T) into the pooled sums of ``suffix``."""
+        if suffix not in self._f:
+            # Shift for the sums of squares: the first chunk's pooled value,
+            # close to the final one, so that no digits cancel.
+            with np.errstate(invalid="ignore", divide="ignore"):
+                shift = fsum.sum(axis=0) / count.sum(axis=0)
+            self._f[suffix] = {"shift": np.nan_to_num(shift), "f": 0.0, "c": 0.0, "gg": 0.0, "gc": 0.0, "cc": 0.0}
+        f = self._f[suffix]
+        g = fsum - f["shift"] * count
+        f["f"] = f["f"] + fsum.sum(axis=0)
+        f["c"] = f["c"] + count.sum(axis=0)
+        f["gg"] = f["gg"] + (g * g).sum(axis=0)
+        f["gc"] = f["gc"] + (g * count).sum(axis=0)
+        f["cc"] = f["cc"] + (count * count).sum(axis=0)
 
     def _mean_sem(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         mean, m2 = self._moments[name]
@@ -326,8 +359,8 @@ class EnsembleStats:
                 out[f"{name}_mean"] = ((), mean[0], {"long_name": f"ensemble mean of {name}", "units": units})
                 out[f"{name}_sem"] = ((), sem[0], {"long_name": f"standard error of {name}_mean over the "
                                                                 f"realizations", "units": units})
-        if self._f:
-            f, R = self._f, self.R
+        for suffix, f in self._f.items():
+            R = self.R
             total = f["c"]
             with np.errstate(invalid="ignore", divide="ignore"):
                 mu_eff = f["f"] / total
@@ -336,13 +369,17 @@ class EnsembleStats:
                 d = mu_eff - f["shift"]
                 resid2 = np.maximum(f["gg"] - 2 * d * f["gc"] + d * d * f["cc"], 0.0)
                 sem = np.sqrt(resid2 / (R * (R - 1))) / (total / R) if R > 1 else _undefined_sem(total.shape)
-            out["mu_eff"] = ("t", mu_eff, ATTRS["mu_eff"])
-            out["mu_eff_sem"] = ("t", np.where(total > 0, sem, np.nan),
-                                 {"long_name": "standard error of mu_eff", "units": "1"})
-            out["mu_eff_count"] = ("t", total.astype(np.int64),
-                                   {"long_name": "number of tilt tests pooled into mu_eff", "units": "1"})
-        if self._capped is not None:
-            out["tilt_capped"] = ("t", self._capped.astype(np.int64), ATTRS["tilt_capped"])
+            name = "mu_eff" + suffix
+            extra = _injected_attrs("mu_eff", self._inject) if suffix else {}
+            out[name] = ("t", mu_eff, {**ATTRS["mu_eff"], **extra})
+            out[name + "_sem"] = ("t", np.where(total > 0, sem, np.nan),
+                                  {**extra, "long_name": f"standard error of {name}, from the spread of the "
+                                                         "realizations' tests", "units": "1"})
+            out[name + "_count"] = ("t", total.astype(np.int64), {
+                **extra, "long_name": f"number of tilt tests pooled into {name}", "units": "1"})
+        for suffix, capped in self._capped.items():
+            extra = _injected_attrs("tilt_capped", self._inject) if suffix else ATTRS["tilt_capped"]
+            out["tilt_capped" + suffix] = ("t", capped.astype(np.int64), extra)
         return out
 
 

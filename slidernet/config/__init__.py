@@ -58,12 +58,11 @@ from slidernet.config.rules import PAIR_TILT_ONLY, choose_kernel, choose_tilt_at
 from slidernet.config.run import NETWORK_OBSERVABLES, OBSERVABLES, Config, Observable
 from slidernet.config.shs import ShsConfig
 from slidernet.config.solver import SolverConfig
-from slidernet.config.tilt import TiltConfig
+from slidernet.config.tilt import InjectConfig, TiltConfig
 from slidernet.config.units import UnitsConfig
 
 __all__ = ["NETWORK_OBSERVABLES", "OBSERVABLES", "PAIR_TILT_ONLY", "SCHEDULER_REQUIREMENT", "Config",
-           "CreepConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "NetworkConfig", "Observable",
-           "PluginSpec", "PositiveFloat", "ShsConfig", "SolverConfig", "StrengtheningConfig", "TiltConfig",
-           "UnitsConfig",
-           "build_distribution", "build_network",
+           "CreepConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig", "NetworkConfig",
+           "Observable", "PluginSpec", "PositiveFloat", "ShsConfig", "SolverConfig", "StrengtheningConfig",
+           "TiltConfig", "UnitsConfig", "build_distribution", "build_network",
            "choose_kernel", "choose_tilt_at", "is_finite", "is_scheduler_address", "load_config", "read_toml"]

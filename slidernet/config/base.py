@@ -97,11 +97,19 @@ class _Strict(BaseModel):
     # did before the key existed, so that the config stored with earlier results and the identity of
     # interrupted runs (run.json) still match it.
     _omit_if_none: ClassVar[tuple[str, ...]] = ()
+    # Keys added later with a default that is the behaviour from before them: left out of a dump at that
+    # default, given or not, for the same reason (and a run that writes the default is the same run).
+    _omit_if_default: ClassVar[tuple[str, ...]] = ()
 
     @model_serializer(mode="wrap")
     def _dump(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
         data = handler(self)
+        if not isinstance(data, dict):
+            return data
         for key in self._omit_if_none:
-            if isinstance(data, dict) and key in data and data[key] is None:
+            if key in data and data[key] is None:
+                del data[key]
+        for key in self._omit_if_default:
+            if key in data and data[key] == type(self).model_fields[key].default:
                 del data[key]
         return data

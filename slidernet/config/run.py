@@ -180,14 +180,8 @@ class Config(_Strict):
                 and choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records"):
             raise ValueError("the 'tilt_loads' observable is read from the network tilt test at the recorded "
                              "times: set 'mu_eff_at = \"records\"'")
-        if self.tilt is not None and not self.tilt.is_default():
-            if "mu_eff" not in self.observables:
-                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test of 'mu_eff', "
-                                 "which is not asked for; add \"mu_eff\" to 'observables' or remove the table")
-            if choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records":
-                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test, and this run's "
-                                 "mu_eff is the appendix's test before every rearrangement: set "
-                                 "'mu_eff_at = \"records\"'")
+        if self.tilt is not None:
+            self._check_tilt_table(self.tilt)
         if self.friction.slip_factor() != 2.0 and self.solver.slip == "exact":
             raise ValueError("'friction.overshoot' sets the length of a straight-line slip, and 'solver.slip = "
                              "\"exact\"' integrates the undamped 2D motion, whose overshoot is 1; use one or the "
@@ -203,6 +197,45 @@ class Config(_Strict):
                              f"in tau_th), so that a reptation velocity is measured after it. "
                              f"Got {self.creep_settings().transient!r} instead")
         return self
+
+    def _check_tilt_table(self, tilt: TiltConfig) -> None:
+        """Refuse a key of [tilt] that acts on tests this run does not make, naming the key and what to set."""
+        if not tilt.is_default():
+            if "mu_eff" not in self.observables:
+                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test of 'mu_eff', "
+                                 "which is not asked for; add \"mu_eff\" to 'observables' or remove the table")
+            if choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records":
+                raise ValueError("the [tilt] table sets the sliding rule of the network tilt test, and this run's "
+                                 "mu_eff is the appendix's test before every rearrangement: set "
+                                 "'mu_eff_at = \"records\"'")
+        missing = self._no_network_tilt_test()
+        if tilt.repeats > 1 and missing is not None:
+            raise ValueError(f"'tilt.repeats' = {tilt.repeats} asks for that many network tilt tests of 'mu_eff' "
+                             f"at each recorded time, and this run makes none: {missing}")
+        if tilt.inject is not None and not self.injected_tests():
+            raise ValueError("'tilt.inject' raises the thresholds of the copy that the network tilt test of "
+                             "'mu_eff' measures at the recorded times, and this run makes no such test: "
+                             f"{missing}")
+        if self.injects_by_age() and self.solver.kernel == "pair":
+            raise ValueError("'tilt.inject' with select < 1 raises the oldest contacts, whose ages need a network "
+                             "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
+
+    def _no_network_tilt_test(self) -> str | None:
+        """Why this run makes no network tilt test at the recorded times, and what to set; None if it makes one."""
+        if "mu_eff" not in self.observables:
+            return "\"mu_eff\" is not in 'observables'; add it"
+        if choose_tilt_at(self.mu_eff_at, self.pair_tilt_applies()) != "records":
+            return ("its mu_eff is the appendix's test of two sliders before every rearrangement; set "
+                    "'mu_eff_at = \"records\"'")
+        return None
+
+    def injected_tests(self) -> list[str]:
+        """The observables whose tests ``[tilt] inject`` raises in this run (the one place of that rule).
+
+        The network tilt test of ``mu_eff`` at the recorded times; an
+        injection with none of them is refused.
+        """
+        return ["mu_eff"] if self._no_network_tilt_test() is None else []
 
     @model_validator(mode="after")
     def _network_observables_can_be_recorded(self) -> Config:
@@ -237,10 +270,16 @@ class Config(_Strict):
 
     def needs_node_state(self) -> bool:
         """True if the scene needs a network kernel's per-node state: the event catalogue, or each node's last
-        slip (observable 'contact_age', or [friction.strengthening]); a two-slider scene then runs on the 'csr'
-        kernel."""
+        slip (observable 'contact_age', [friction.strengthening], or [tilt] inject with select < 1); a
+        two-slider scene then runs on the 'csr' kernel."""
         return (self.needs_catalogue() or "contact_age" in self.observables
-                or self.friction.strengthening is not None)
+                or self.friction.strengthening is not None or self.injects_by_age())
+
+    def injects_by_age(self) -> bool:
+        """True if ``[tilt] inject`` raises the oldest contacts only (``select < 1``): it reads each node's
+        last slip, as the observable 'contact_age' does."""
+        inject = self.tilt_settings().inject
+        return inject is not None and inject.select < 1.0
 
     def pair_tilt_applies(self, network: Network | None = None) -> bool:
         """True if the appendix's tilt test before every rearrangement can be this run's mu_eff: a 1D pair

@@ -76,7 +76,10 @@ Attributes
     ``slidernet_version``, ``slidernet_code``, ``seed``, ``kernel``, ``execution``: the last
     point's), plus ``sweep`` (the grid) and ``configs`` (every point's resolved configuration, C order). Where
     the points' kernels differ, ``kernel`` lists the distinct ones, comma
-    separated, and ``kernels`` (JSON) gives each point's, in C order.
+    separated, and ``kernels`` (JSON) gives each point's, in C order. A
+    variable keeps the attributes every point gives it alike; one that
+    differs between points (``inject_select`` where ``tilt.inject.select``
+    is swept) is left out: each point's configuration holds its value.
 
 With ``out``, point i (its grid position in C order: the last key varies
 fastest) runs in ``out/points/<i>/`` with the runner's checkpoints there, and
@@ -684,6 +687,13 @@ def _coordinate(values: list[Any]) -> np.ndarray:
     return np.array([json.dumps(v, sort_keys=True) for v in values], dtype=str)
 
 
+def _common_attrs(attrs: list[dict[str, Any]]) -> dict[str, Any]:
+    """The attributes of a variable that every point gives alike: one that differs between points (the
+    injection's ``inject_c`` where ``tilt.inject.c`` is swept) is each point's own, in its configuration."""
+    return {key: value for key, value in attrs[0].items()
+            if all(key in a and np.array_equal(a[key], value) for a in attrs[1:])}
+
+
 def _union(names: list[list[str]]) -> list[str]:
     """The names of every list, each once, in the order of first appearance."""
     return list(dict.fromkeys(n for group in names for n in group))
@@ -735,7 +745,7 @@ def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list
             for i, r in enumerate(results):
                 if name in r.data_vars:
                     flat[i] = r[name].values
-        ds[name] = ((*dims, *var.dims), data, dict(var.attrs))
+        ds[name] = ((*dims, *var.dims), data, _common_attrs([r[name].attrs for r in have]))
     if not split_nodes:
         return ds, []
     if "sweep_point" not in taken | set(dims):

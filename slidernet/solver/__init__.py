@@ -13,9 +13,13 @@
 - :mod:`~slidernet.solver.creep`: the creep observables of one realization
   (x_G per cycle, the reptation velocity, the creep events), reduced from its
   event catalogue.
+- :mod:`~slidernet.solver.inject`: :func:`injected_thresholds`, the raised
+  copy of the thresholds that the injected twin of a test reads
+  (``[tilt] inject``).
 """
 
 from slidernet.model.network import pair_tilt_applies
+from slidernet.solver.inject import injected_thresholds
 from slidernet.solver.realization import Realization, simulate
 from slidernet.solver.scene import (
     EVENT_CHUNK,
@@ -28,5 +32,5 @@ from slidernet.solver.snapshot import Snapshot
 from slidernet.solver.streams import Streams, draw_thetas, horizontal_draws, realization_streams
 
 __all__ = ["EVENT_CHUNK", "Realization", "Scene", "Snapshot", "Streams", "build_network", "draw_thetas",
-           "horizontal_draws", "pair_tilt_applies", "realization_streams", "record_times", "simulate",
-           "tilt_avalanche_cap"]
+           "horizontal_draws", "injected_thresholds", "pair_tilt_applies", "realization_streams", "record_times",
+           "simulate", "tilt_avalanche_cap"]

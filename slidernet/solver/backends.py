@@ -10,6 +10,7 @@ HOOMD-blue separates a simulation's State from its Operations:
 
 - ``run(real, thetas)``: call the compiled kernel; returns its status code;
 - ``forces(real)``, ``displacements(real)``: the state in physical form;
+- ``last_slip(real)``: each node's last slip time, where the scene keeps it;
 - ``recompute(real)``: reset incremental forces from the displacements;
 - ``flush_events(real)``, ``events(real)``: the event catalogue;
 - ``records(T)``, ``result(real)``: the kernel's own records and results;
@@ -107,6 +108,10 @@ class PairBackend:
     def recompute(self, real: Host) -> float:
         return 0.0
 
+    def last_slip(self, real: Host) -> np.ndarray:
+        """Each node's last slip time: none kept (a scene that needs them runs on a network kernel)."""
+        return np.zeros(0)
+
     def flush_events(self, real: Host) -> None:  # pragma: no cover - the scene never asks it
         raise RuntimeError("the pair kernel keeps no event catalogue")
 
@@ -145,8 +150,8 @@ class NetworkBackend:
                       avalanche_count=np.zeros(kernels.N_AVALANCHE_BINS, np.int64),
                       # Read only where the scene can slide away: 0-length elsewhere.
                       moving=np.full(N if scene.slide_away else 0, -1, np.int64),
-                      # Read and written only where the scene records contact_age or its contacts strengthen.
-                      last_slip=np.zeros(N if scene.contact_age or strong else 0))
+                      # Read and written only where the scene keeps the contacts' ages (Scene.keeps_ages).
+                      last_slip=np.zeros(N if scene.keeps_ages else 0))
         # With strengthening, the type the *_aging kernels are compiled for: its drawn thresholds and its law.
         self.nodes: kernels.Nodes | kernels.AgingNodes = (
             kernels.AgingNodes(**fields, mu0=real.mu.copy(), law=np.array(scene.strengthening, np.float64))
@@ -187,6 +192,11 @@ class NetworkBackend:
 
     def displacements(self, real: Host) -> np.ndarray:
         return self.nodes.u.reshape(self.scene.network.n_nodes, -1)
+
+    def last_slip(self, real: Host) -> np.ndarray:
+        """Each node's last slip time, in tau_th (0: never slipped), shape (N,); 0-length unless the scene keeps
+        the ages (``Scene.keeps_ages``)."""
+        return self.nodes.last_slip
 
     def recompute(self, real: Host) -> float:
         g = self.scene.operators.g

@@ -35,6 +35,8 @@ _PROBE_CHAIN = 8
 _PROBE_IRREGULAR = 32
 _PROBE_SIDE = 4
 _PROBE_SLIPS = 2000
+# The largest theta / Ntilde a probe is driven with (see probe_config).
+_PROBE_DRIVE = 100.0
 
 # CPU seconds to compile each part from an empty cache, one process, on the project's 2-core dev machine
 # (2026-11-27, `python benchmarks/cold_start.py`); the notice's estimate is their sum.
@@ -59,7 +61,9 @@ def probe_config(cfg: Config) -> Config | None:
 
     Only the size changes (a chain of at most 8 sliders, a lattice of at
     most 4 x 4, an irregular network of at most 32; a graph read from a file
-    is kept whole), ``solver.max_avalanche`` (2000 slips), and a plugin that
+    is kept whole), ``solver.max_avalanche`` (2000 slips), Ntilde (raised to
+    the largest ``|theta|`` of two steps of the driver where that passes 100
+    Ntilde: a drive of the study's strength, a few slips a step), and a plugin that
     is not a built-in, replaced by a built-in of its kind (a Gaussian law, a
     driver of Gaussian steps), so the probe runs the same compiled kernels as
     ``cfg``, stops soon, and never calls a user's plugin.
@@ -90,7 +94,19 @@ def probe_config(cfg: Config) -> Config | None:
         rows, cols = net["shape"]
         net["shape"] = [min(rows, _PROBE_SIDE), min(cols, _PROBE_SIDE)]
     try:
-        return load_config(data)
+        probe = load_config(data)
+        # A probe drives its network as the study's runs do, theta / Ntilde of order one: a few slips a step.
+        # Far more (sigma_theta = 1 at Ntilde = 1e-7: the configuration fuzz) made two steps of a 4 x 4
+        # lattice take ~1e8 slips in a kernel that holds the process, before the run's signal handling.
+        # What numba compiles does not depend on Ntilde, so where the largest |theta| of the driver's two
+        # steps passes 100 Ntilde, the probe's Ntilde is raised to it (the [units] table, which would set
+        # it back, goes).
+        largest = float(np.abs(probe.driver_plugin().thetas(np.random.default_rng(0), 2)).max())
+        if largest > _PROBE_DRIVE * data["network"]["Ntilde"]:
+            data.pop("units", None)
+            data["network"]["Ntilde"] = largest
+            probe = load_config(data)
+        return probe
     except SlidernetError:
         return None
 

@@ -13,6 +13,7 @@ one rearrangement to the next by solving eq. `critique` exactly.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -22,6 +23,7 @@ from slidernet.errors import AvalancheError, SnapshotError, TiltTestError
 from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver.backends import backend_for
 from slidernet.solver.creep import creep_record
+from slidernet.solver.inject import injected_thresholds
 from slidernet.solver.scene import Scene, tilt_avalanche_cap
 from slidernet.solver.snapshot import Snapshot, check_fingerprint, digest, scene_fingerprint, take
 from slidernet.solver.streams import Streams
@@ -111,6 +113,7 @@ class Realization:
         if scene.shs_stiffness is not None:
             # NaN where no pull was made: the recorded times after the network slid away.
             self.out.update(mu_shs=np.full(T, np.nan), shs_travel=np.full(T, np.nan))
+        self.out.update(_more_tilt_records(scene, T))
         self._tilted = 0  # recorded times whose network tilt test (and slide-hold-slide pull) is done
         self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._shs_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
@@ -234,7 +237,7 @@ class Realization:
         """True once the network slid away (docs/model.md, 'Sliding away'): the realization is over."""
         return bool(self.state["slid_away"][0])
 
-    def tilt_test(self) -> float:
+    def tilt_test(self, mu: np.ndarray | None = None, *, advance: bool = True) -> float:
         """One network tilt test on a copy of the current state: mu_eff, the load at which it slides.
 
         Raises the uniform tangential force f N_i along +x on every node until
@@ -243,6 +246,16 @@ class Realization:
         tangential load per unit normal load at that moment, f plus the mean
         f_ext along x. The state is left as it was; the draws come from the
         realization's tilt stream.
+
+        Parameters
+        ----------
+        mu : ndarray of float64, shape (N,), optional
+            The thresholds to test, which the test overwrites (default: a
+            copy of the realization's; :meth:`tested_thresholds`).
+        advance : bool
+            True: the tilt stream goes on after the draws this test read.
+            False: it stays where it was, so that the next test reads the
+            same draws (the injected twin of ``[tilt] inject``).
         """
         from slidernet.kernels import tilt_net
 
@@ -250,7 +263,7 @@ class Realization:
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         (heaps, epoch, count, pos, loads), G = self._test_work("_tilt_work")
-        mu = self.mu.copy()
+        mu = self.mu.copy() if mu is None else mu
         st = self.state
         pos[:] = 0
         pos[tilt_net.P_MU], pos[tilt_net.P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
@@ -262,7 +275,8 @@ class Realization:
                        cap, heaps, epoch, count, loads)
             status = kernels.tilt_status(f)
             if status == kernels.DONE:
-                st["tilt_mu_pos"], st["tilt_u_pos"] = pos[tilt_net.P_MU], pos[tilt_net.P_U]
+                if advance:
+                    st["tilt_mu_pos"], st["tilt_u_pos"] = pos[tilt_net.P_MU], pos[tilt_net.P_U]
                 return float(f)
             if status != kernels.NEED_TILT:
                 raise TiltTestError(self._tilt_stop_reason(pos, float(loads[tilt_net.L_F] + o.f_bar), cap))
@@ -358,21 +372,63 @@ class Realization:
         """
         return self.streams.refill(status, self.state)
 
+    def tested_thresholds(self, k: int, injected: bool) -> np.ndarray:
+        """A copy of the thresholds that a test at recorded time ``k`` reads, shape (N,).
+
+        ``injected``: raised by ``[tilt] inject`` at t = ``scene.out_steps[k]``
+        (:func:`~slidernet.solver.inject.injected_thresholds`); else the
+        realization's own. The realization's thresholds are left as they are.
+        """
+        if not injected:
+            return self.mu.copy()
+        if self.scene.inject is None:
+            raise ValueError("this scene injects nothing ([tilt] inject is not set)")
+        return injected_thresholds(self.mu, self.backend.last_slip(self), float(self.scene.out_steps[k]),
+                                   self.scene.inject)
+
     def _tilt_record(self, k: int) -> None:
+        """The network tilt tests at recorded time ``k``: ``[tilt] repeats`` of them, each with its injected twin
+        under ``[tilt] inject``."""
+        plain, injected = [], []
+        for _ in range(self.scene.tilt_repeats):
+            if self.scene.inject is not None:
+                # The twin first, leaving the stream where it was: the plain test then reads the same draws
+                # and moves the stream on exactly as in a run without injection.
+                try:
+                    injected.append(self._one_tilt_test(self.tested_thresholds(k, True), advance=False))
+                except TiltTestError as exc:
+                    raise TiltTestError(f"The injected twin ([tilt] inject) of a test: {exc}") from None
+            plain.append(self._one_tilt_test(self.tested_thresholds(k, False), advance=True))
+        self._store_tilt_tests(k, plain, "")
+        if injected:
+            self._store_tilt_tests(k, injected, "_injected")
+
+    def _one_tilt_test(self, mu: np.ndarray, advance: bool) -> tuple[float, bool, float, float]:
+        """(sample, met the avalanche cap before the [tilt] rule, load at the first slip, load when every node
+        first moved) of one network tilt test on the thresholds ``mu``."""
         from slidernet.kernels.tilt_net import L_FIRST, L_MOVING, STOP, STOP_CAP
 
-        f = self.tilt_test()
-        if self.scene.counts_capped and self._tilt_work[3][STOP] == STOP_CAP:
-            # The avalanche cap's sample, not the stricter rule's: counted, never pooled into mu_eff as the rule's.
-            self.out["tilt_capped"][k] += 1
-        else:
-            self.out["f_sum"][k] += f
-            self.out["f_sq"][k] += f * f
-            self.out["f_count"][k] += 1
+        f = self.tilt_test(mu, advance=advance)
+        _, _, _, pos, loads = self._tilt_work
+        return f, self.scene.counts_capped and pos[STOP] == STOP_CAP, float(loads[L_FIRST]), float(loads[L_MOVING])
+
+    def _store_tilt_tests(self, k: int, tests: list[tuple[float, bool, float, float]], suffix: str) -> None:
+        """Add the tests at recorded time ``k`` to the records named with ``suffix`` ("" or "_injected")."""
+        out = self.out
+        sampled = [f for f, capped, _, _ in tests if not capped]
+        if self.scene.counts_capped:
+            # The avalanche cap's samples, not the stricter rule's: counted, never pooled into mu_eff as the
+            # rule's.
+            out["tilt_capped" + suffix][k] += len(tests) - len(sampled)
+        for f in sampled:
+            out["f_sum" + suffix][k] += f
+            out["f_sq" + suffix][k] += f * f
+            out["f_count" + suffix][k] += 1
+        if "mu_eff_spread" + suffix in out and len(sampled) > 1:
+            out["mu_eff_spread" + suffix][k] = np.std(sampled, ddof=1)
         if self.scene.tilt_loads:
-            loads = self._tilt_work[4]
-            self.out["tilt_first_slip"][k] = loads[L_FIRST]
-            self.out["tilt_all_moving"][k] = loads[L_MOVING]
+            out["tilt_first_slip" + suffix][k] = _mean_of_events([first for _, _, first, _ in tests])
+            out["tilt_all_moving" + suffix][k] = _mean_of_events([moving for _, _, _, moving in tests])
 
     def _shs_record(self, k: int) -> None:
         self.out["mu_shs"][k], self.out["shs_travel"][k] = self.shs_test()
@@ -517,8 +573,10 @@ class Realization:
             ``n``, ``n_records`` (int64), ``mu_max``, ``x_G`` (in l0) of shape
             (T,), the tilt-test sums ``f_sum``, ``f_sq``, ``f_count`` per
             record bin, shape (T,) (under a stricter sliding rule, ``tilt_capped``:
-            the tests that met the avalanche cap first, which these leave out),
-            with ``mu_shs`` its pull's peak and the stage's travel there (l0),
+            the tests that met the avalanche cap first, which these leave out;
+            with ``[tilt] repeats`` > 1, ``mu_eff_spread``; with ``[tilt] inject``,
+            the same of the injected twins, named ``*_injected``), with the
+            observable ``mu_shs`` its pull's peak and the stage's travel there (l0),
             ``mu_shs`` and ``shs_travel`` (NaN after the network slid away),
             and the scalar ``n_events``; where the
             scene can slide away (``scene.records_slide``), the scalar
@@ -532,6 +590,9 @@ class Realization:
         if "y_G" in res:
             res["y_G"] *= Ntilde
         res["n_events"] = np.int64(self.state["n_events"][0])
+        if self.scene.inject is not None:  # what the *_injected records hold: (c, t0, select)
+            inj = self.scene.inject
+            res["inject"] = np.array([inj.c, inj.t0, inj.select], np.float64)
         if self.scene.records_slide:
             res["slid_away_at"] = np.float64(self.state["slid_away_at"][0] if self.slid_away else np.nan)
         res.update(self.backend.result(self))
@@ -542,6 +603,28 @@ class Realization:
             # Kept for the creep observables only: the rows stay out of the records.
             del res["events"], res["events_complete"]
         return res
+
+
+def _more_tilt_records(scene: Scene, T: int) -> dict[str, np.ndarray]:
+    """The records of ``[tilt] repeats`` (``mu_eff_spread``) and of ``[tilt] inject`` (the injected twins' sums,
+    and their loads and cap counts where the plain tests have them), shape (T,) each."""
+    out: dict[str, np.ndarray] = {}
+    if scene.tilt_repeats > 1:
+        out["mu_eff_spread"] = np.full(T, np.nan)
+    if scene.inject is not None:
+        out.update(f_sum_injected=np.zeros(T), f_sq_injected=np.zeros(T), f_count_injected=np.zeros(T, np.int64))
+        if scene.tilt_loads:
+            out.update(tilt_first_slip_injected=np.full(T, np.nan), tilt_all_moving_injected=np.full(T, np.nan))
+        if scene.counts_capped:
+            out["tilt_capped_injected"] = np.zeros(T, np.int64)
+    return out
+
+
+def _mean_of_events(loads: list[float]) -> float:
+    """The mean of a record's loads over its tests where the event happened (NaN: in none); one test's load as
+    it is."""
+    seen = [x for x in loads if not np.isnan(x)]
+    return math.fsum(seen) / len(seen) if seen else math.nan
 
 
 def simulate(scene: Scene, seed_seq: np.random.SeedSequence) -> dict[str, np.ndarray]:

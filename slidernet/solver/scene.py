@@ -9,7 +9,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from slidernet.config import Config, build_network, choose_kernel, choose_tilt_at
+from slidernet.config import Config, InjectConfig, build_network, choose_kernel, choose_tilt_at
 from slidernet.errors import ConfigError
 from slidernet.kernels import Chain, Plane, Settings, tilt_net
 from slidernet.kernels.assembly import diagonal_positions
@@ -220,6 +220,8 @@ class Scene:
     tilt_min_slips: int = 1  # the network tilt test's sliding rule (the [tilt] table)
     tilt_min_shift: float = 0.0  # ... and the centre of mass's displacement it needs, in Ntilde l0
     shs_stiffness: float | None = None  # [shs] stiffness gamma with the observable mu_shs; None: no pull
+    tilt_repeats: int = 1  # network tilt tests per recorded time ([tilt] repeats)
+    inject: InjectConfig | None = None  # the aging injected into the tested copy ([tilt] inject); None: none
     operators: Chain | Plane | None = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
     _shs_operators: ShsOperators | None = field(default=None, repr=False)
@@ -239,6 +241,13 @@ class Scene:
         ``tilt_capped``, not sampled. Under the default rule that cap's sample is the rule's own (a part
         sliding alone above mu_d)."""
         return self.tilt_at == "records" and (self.tilt_min_slips > 1 or self.tilt_min_shift > 0.0)
+
+    @property
+    def keeps_ages(self) -> bool:
+        """True if the network kernel keeps each node's last slip time: for the observable 'contact_age',
+        strengthening contacts, or an injection into the oldest contacts (``[tilt] inject``, select < 1)."""
+        return (self.contact_age or self.strengthening is not None
+                or (self.inject is not None and self.inject.select < 1.0))
 
     @property
     def do_tilt(self) -> bool:
@@ -326,6 +335,9 @@ class Scene:
             slip_factor=cfg.friction.slip_factor(),
             tilt_min_slips=tilt.min_slips,
             tilt_min_shift=min_shift,
+            tilt_repeats=tilt.repeats if tilt_at == "records" else 1,
+            # Where a test it raises runs (Config.injected_tests, the one rule).
+            inject=tilt.inject if tilt_at == "records" and cfg.injected_tests() else None,
             shs_stiffness=cfg.shs_settings().stiffness if "mu_shs" in cfg.observables else None,
             operators=operators,
         )

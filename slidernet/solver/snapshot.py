@@ -110,6 +110,9 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         "tilt_min_shift": float(scene.tilt_min_shift),
         # Only where contacts strengthen: a scene without it keeps the fingerprint of earlier snapshots.
         **({} if scene.strengthening is None else {"strengthening": list(scene.strengthening)}),
+        # Likewise [tilt] repeats and inject, only where set.
+        **({} if scene.tilt_repeats == 1 else {"tilt_repeats": int(scene.tilt_repeats)}),
+        **({} if scene.inject is None else {"inject": scene.inject.model_dump(mode="json")}),
         # Only with the slide-hold-slide pull, likewise.
         **({} if scene.shs_stiffness is None else {"shs_stiffness": float(scene.shs_stiffness)}),
         "distribution": scene.distribution_name,
