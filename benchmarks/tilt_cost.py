@@ -2,7 +2,7 @@
 
     python benchmarks/tilt_cost.py [--sizes 100 1000 10000] [--lattices 10 32] [--realizations 8]
                                    [--tests 2] [--age 3] [--seed 1] [--core 0] [--max-avalanche S]
-                                   [--overshoot E] [--min-slips M] [--min-displacement X] [--shs KAPPA]
+                                   [--overshoot E] [--min-slips M] [--min-displacement X] [--shs GAMMA]
                                    [--csv PATH] [--quick]
 
 The network tilt test (:meth:`slidernet.solver.Realization.tilt_test`, kernel
@@ -86,9 +86,9 @@ compare (the rule is printed in the first line). A configuration with a
 ``--min-displacement`` the scenes record ``mu_eff`` at t = 0: one untimed
 test of the fresh state, which also fills part of the tilt draw buffers.
 
-``--shs KAPPA`` times the slide-hold-slide pull instead
+``--shs GAMMA`` times the slide-hold-slide pull instead
 (:meth:`slidernet.solver.Realization.shs_test`, the observable ``mu_shs``
-with ``[shs] stiffness = KAPPA``): the same body as the tilt test, pulled
+with ``[shs] stiffness = GAMMA``): the same body as the tilt test, pulled
 through springs until every node has slipped. Its scenes record ``mu_shs``
 at t = 0 (one untimed pull) and run to ``--age`` + 1 steps, so that no
 timed thermal step holds a pull; its slips are counted from the ``shs``
@@ -554,8 +554,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--overshoot", type=float, default=None, help="friction.overshoot e in [0, 1] (default 1)")
     ap.add_argument("--min-slips", type=int, default=None, help="[tilt] min_slips (default 1)")
     ap.add_argument("--min-displacement", type=float, default=None, help="[tilt] min_displacement (default 0)")
-    ap.add_argument("--shs", type=float, default=None, metavar="KAPPA",
-                    help="time the slide-hold-slide pull with [shs] stiffness = KAPPA instead of the tilt test")
+    ap.add_argument("--shs", type=float, default=None, metavar="GAMMA",
+                    help="time the slide-hold-slide pull with [shs] stiffness = GAMMA instead of the tilt test")
     ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
     ap.add_argument("--quick", action="store_true", help="a smoke run of a few seconds")
     args = ap.parse_args(argv)

@@ -138,6 +138,90 @@ def test_a_relaxed_chain_of_equal_thresholds_gives_that_threshold_in_both_tests(
     assert r.shs_test()[0] == 0.62 == r.tilt_test()
 
 
+# --- injected aging ([tilt] inject) on the pull -----------------------------------------------------------------
+
+
+def _at_rest(network: dict[str, Any], observables: tuple[str, ...], **changes: Any) -> dict[str, Any]:
+    """Every threshold (and redraw) 0.6, theta fixed at 0: no spring ever stretched, no slip in the hold."""
+    return config(network, observables=observables, realizations=2, steps=100, record="log",
+                  log_points_per_decade=2, friction={"mu_d": 0.5, "static": {"name": "constant", "value": 0.6}},
+                  driver={"name": "constant", "theta0": 0.0}, **changes)
+
+
+@pytest.mark.parametrize("stiffness", [0.25, 1.0, 4.0], ids=["soft", "unit", "stiff"])
+@pytest.mark.parametrize("network", [{"kind": "two_slider"}, {"kind": "chain", "n": 2}, {"kind": "chain", "n": 5}],
+                         ids=["pair-kernel", "chain-2", "chain-5"])
+@pytest.mark.parametrize(("c", "t0"), [(0.01, 1.0), (0.3, 7.5)], ids=["c-0.01", "c-0.3-t0-7.5"])
+def test_a_pull_of_raised_equal_thresholds_peaks_exactly_the_shift_higher_as_the_tilt_test(network, stiffness,
+                                                                                          c, t0):
+    # Equal thresholds on springs at rest: the pull peaks at its first slip, at the threshold itself (the hand
+    # case above: the first slip pushes the next node past its threshold, and the stage force only drops
+    # after it). Raised by s(t) = c ln(1 + t/t0), every threshold of the twin's copy is 0.6 + s, and its pull
+    # peaks at 0.6 + s, to the bit; the redraws (0.6, young contacts) come after the peak. The tilt test's
+    # twin reads the same, 0.6 + s: here the two estimators agree, with and without the injection.
+    cfg = _at_rest(network, ("n", "mu_eff", "mu_shs"), mu_eff_at="records", shs={"stiffness": stiffness},
+                   tilt={"inject": {"c": c, "t0": t0}})
+    ds = slidernet.run(cfg)
+    t = ds["t"].values
+    assert t.tolist() == [0, 1, 3, 10, 32, 100] and int(ds["n"].max()) == 0
+    raised = np.array([0.6 + c * math.log1p(float(time) / t0) for time in t])
+    np.testing.assert_array_equal(ds["mu_shs"].values, np.full((2, t.size), 0.6))
+    np.testing.assert_array_equal(ds["mu_shs_injected"].values, np.stack([raised, raised]))
+    np.testing.assert_array_equal(ds["mu_shs_injected_mean"].values, raised)
+    np.testing.assert_array_equal(ds["mu_shs_injected_sem"].values, np.zeros(t.size))
+    np.testing.assert_array_equal(ds["mu_eff_injected"].values, raised)
+    attrs = ds["mu_shs_injected"].attrs
+    assert (attrs["inject_c"], attrs["inject_t0"], attrs["inject_select"]) == (c, t0, 1.0)
+    assert "shs for the slide-hold-slide pull" in attrs["pairing"]
+    assert ds["mu_shs_injected"].dims == ds["mu_shs"].dims == ("realization", "t")
+
+
+def test_the_injection_applies_to_the_pull_alone_where_no_network_tilt_test_runs():
+    # [tilt] inject with mu_shs and no mu_eff: the pull has its twin; no tilt test is made, none is recorded.
+    cfg = _at_rest({"kind": "chain", "n": 3}, ("n", "mu_shs"), tilt={"inject": {"c": 0.02}})
+    ds = slidernet.run(cfg)
+    assert {name for name in ds.data_vars if "injected" in name} == {"mu_shs_injected", "mu_shs_injected_mean",
+                                                                    "mu_shs_injected_sem"}
+    raised = 0.6 + 0.02 * np.log1p(ds["t"].values.astype(float))
+    np.testing.assert_allclose(ds["mu_shs_injected_mean"].values, raised, rtol=0, atol=1e-15)
+    # The pair whose mu_eff is the appendix's test before every rearrangement: the pull's twin only.
+    pair = slidernet.run(_at_rest({"kind": "two_slider"}, ("n", "mu_eff", "mu_shs"), tilt={"inject": {"c": 0.02}}))
+    assert pair.attrs["kernel"] == "pair" and "mu_eff" in pair
+    assert "mu_shs_injected" in pair and "mu_eff_injected" not in pair
+
+
+def test_an_injection_with_neither_test_is_refused_naming_both():
+    message = (r"'tilt\.inject' raises the thresholds of the copy that a test of static friction measures .* the "
+               r"slide-hold-slide pull of 'mu_shs'\), and this run makes neither: \"mu_eff\" is not in "
+               r"'observables'; add it, or add \"mu_shs\" to 'observables'")
+    with pytest.raises(ConfigError, match=message):
+        load_config(config({"kind": "chain", "n": 4}, observables=("n",), tilt={"inject": {"c": 0.01}}))
+
+
+@pytest.mark.parametrize("select", [1.0, 0.5], ids=["select-1", "select-0.5"])
+def test_the_pull_s_twin_reads_the_raised_copy_and_the_same_draws(select):
+    # Run by hand: at every record the twin is the pull on tested_thresholds(k, True) from the shs stream's
+    # position before the plain pull, and it leaves that position where it was.
+    scene = scene_of({"kind": "irregular", "n": 12}, observables=("n", "mu_shs"), steps=20,
+                     tilt={"inject": {"c": 0.03, "t0": 2.0, "select": select}})
+    r = Realization(scene, np.random.SeedSequence(4))
+    for k, t in enumerate(scene.out_steps):
+        r._run_kernel(int(t), None)  # the state at t, before the record's tests (advance would make them)
+        start = int(r.state["shs_mu_pos"][0])
+        raised = r.tested_thresholds(k, True)
+        shift = scene.inject.shift(float(t))
+        assert np.count_nonzero(raised != r.mu) == (0 if shift == 0 else math.ceil(select * 12))
+        G = np.zeros((12, 2))
+        G[:, : scene.network.dim] = r.forces().reshape(12, -1)
+        twin = pull(scene, G, raised, r.buffers.shs_mu[start:], max_slips=scene.max_avalanche)
+        plain = pull(scene, G, r.mu, r.buffers.shs_mu[start:], max_slips=scene.max_avalanche)
+        r.advance(int(t))
+        assert r.out["mu_shs_injected"][k] == twin["peak"]
+        assert r.out["mu_shs"][k] == plain["peak"]
+        assert r.state["shs_mu_pos"][0] == start + plain["drawn"]
+        assert twin["drawn"] > 0 and plain["drawn"] > 0
+
+
 # --- the pull against its stated rule, by brute force --------------------------------------------------------
 
 

@@ -55,7 +55,8 @@ ATTRS = {
 }
 
 #: The pairing every injected variable rests on, in its attributes with the injection's c, t0 and select.
-PAIRING = ("each test at t is made twice, on the same state with the same draws of the tilt stream: as it is "
+PAIRING = ("each test at t is made twice, on the same state with the same draws of its stream (tilt; shs for the "
+           "slide-hold-slide pull): as it is "
            "(the plain variable) and on a copy whose thresholds mu_s are raised by "
            "inject_c ln(1 + t / inject_t0), those of the ceil(inject_select N) oldest contacts (all with "
            "inject_select = 1); a contact that slips in the test draws a fresh threshold without the rise")
@@ -197,7 +198,7 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     inject = records[0].get("inject")
     for suffix in ("", "_injected") if inject is not None else ("",):
         attrs = (lambda name: ATTRS[name]) if not suffix else (lambda name: _injected_attrs(name, inject))
-        if "mu_eff_realization" in observables:
+        if "mu_eff_realization" in observables and "f_count" + suffix in records[0]:
             # Each realization's own mean of its tilt tests in the bin: independent across realizations,
             # so trends and errors of mu_eff can come from the spread of realizations, not of time bins.
             count = np.stack([r["f_count" + suffix] for r in records]).astype(np.float64)
@@ -256,6 +257,8 @@ class EnsembleStats:
     """
 
     MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age", "mu_shs")
+    #: Of those, the ones an injected twin of ``[tilt] inject`` has, named ``<name>_injected`` in the records.
+    INJECTED_MOMENTS = ("mu_shs",)
 
     def __init__(self, observables: list[str], steps: int) -> None:
         self.observables = list(observables)
@@ -290,6 +293,8 @@ class EnsembleStats:
                 self._merge(name, x)
                 if name == "x_G":
                     self._merge("x_G2", x**2)
+            if name in self.INJECTED_MOMENTS and name + "_injected" in records[0]:
+                self._merge(name + "_injected", np.stack([r[name + "_injected"] for r in records]).astype(float))
         if "n" in self.observables and self.steps > 0:
             self._merge("r", np.array([[r["n"][-1] / self.steps] for r in records]))
         if "contact_age" in self.observables:
@@ -344,6 +349,12 @@ class EnsembleStats:
                 mean, sem = self._mean_sem("x_G2")
                 out["x_G2_mean"] = ("t", mean, {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
                 out["x_G2_sem"] = ("t", sem, {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+            if name + "_injected" in self._moments:
+                twin = f"{name}_injected"
+                extra = {**_injected_attrs(name, self._inject), "long_name": f"ensemble mean of {twin}"}
+                mean, sem = self._mean_sem(twin)
+                out[f"{twin}_mean"] = ("t", mean, extra)
+                out[f"{twin}_sem"] = ("t", sem, {**extra, "long_name": f"standard error of {twin}_mean"})
         if self._age_count is not None:
             out["contact_age_count"] = (("t", "contact_age_bin"), self._age_count, {
                 "long_name": "number of (realization, node) pairs whose contact age at t lies in the bin "

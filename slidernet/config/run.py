@@ -213,9 +213,10 @@ class Config(_Strict):
             raise ValueError(f"'tilt.repeats' = {tilt.repeats} asks for that many network tilt tests of 'mu_eff' "
                              f"at each recorded time, and this run makes none: {missing}")
         if tilt.inject is not None and not self.injected_tests():
-            raise ValueError("'tilt.inject' raises the thresholds of the copy that the network tilt test of "
-                             "'mu_eff' measures at the recorded times, and this run makes no such test: "
-                             f"{missing}")
+            raise ValueError("'tilt.inject' raises the thresholds of the copy that a test of static friction "
+                             "measures at the recorded times (the network tilt test of 'mu_eff', the "
+                             "slide-hold-slide pull of 'mu_shs'), and this run makes neither: "
+                             f"{missing}, or add \"mu_shs\" to 'observables'")
         if self.injects_by_age() and self.solver.kernel == "pair":
             raise ValueError("'tilt.inject' with select < 1 raises the oldest contacts, whose ages need a network "
                              "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
@@ -232,10 +233,12 @@ class Config(_Strict):
     def injected_tests(self) -> list[str]:
         """The observables whose tests ``[tilt] inject`` raises in this run (the one place of that rule).
 
-        The network tilt test of ``mu_eff`` at the recorded times; an
+        The network tilt test of ``mu_eff`` at the recorded times, and the
+        slide-hold-slide pull of ``mu_shs``: each alone, or both; an
         injection with none of them is refused.
         """
-        return ["mu_eff"] if self._no_network_tilt_test() is None else []
+        return ([name for name, runs in (("mu_eff", self._no_network_tilt_test() is None),
+                                         ("mu_shs", "mu_shs" in self.observables)) if runs])
 
     @model_validator(mode="after")
     def _network_observables_can_be_recorded(self) -> Config:

@@ -61,13 +61,13 @@ rule (``friction.overshoot`` e < 1) the pair's test is the appendix's with
 that slip, as :func:`slidernet.kernels.tilt.tilt_test_pair` makes it.
 
 **Slide-hold-slide** (:func:`shs_test_network`, docs/model.md "Slide-hold-slide") is the same body
-with ``pull`` = kappa <k> > 0: a stage at X along +x is joined to every node i by a spring of stiffness
-kappa N_i <k>, so node i feels G_i + kappa N_i <k> (X - u_i,x) x, u_i its displacement since the pull
-began. That is the tilt f N_i above with f = kappa <k> X, on a network whose diagonal blocks K_ii hold
-the pull spring kappa N_i <k> along x (the caller's ``net``): the critical f, the slips (with the local
+with ``pull`` = gamma <k> > 0: a stage at X along +x is joined to every node i by a spring of stiffness
+gamma N_i <k>, so node i feels G_i + gamma N_i <k> (X - u_i,x) x, u_i its displacement since the pull
+began. That is the tilt f N_i above with f = gamma <k> X, on a network whose diagonal blocks K_ii hold
+the pull spring gamma N_i <k> along x (the caller's ``net``): the critical f, the slips (with the local
 stiffness pull spring included), the avalanches and the redraws are the tilt test's. Every slip relaxes
 a pull spring, so every avalanche at fixed X ends: no rule 3 or 4. The stage force per unit normal load,
-F / sum N = f - kappa <k> U (U = sum_i N_i u_i,x / sum N), rises with f between slips and drops at each
+F / sum N = f - gamma <k> U (U = sum_i N_i u_i,x / sum N), rises with f between slips and drops at each
 forward slip; its peak plus f_bar is the sample ``loads[L_PEAK]``, and the pull ends at the slip that
 renews the last contact: every node has slipped at least once since it began.
 
@@ -252,8 +252,8 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
     pull : float
         0.0: the tilt test (a constant of its compiled variants, so that the
         pull's branches fold away there). > 0: the slide-hold-slide pull
-        (:func:`shs_test_network`), ``pull`` = kappa <k>, with the pull
-        springs kappa <k> N_i along x already in the diagonal blocks of
+        (:func:`shs_test_network`), ``pull`` = gamma <k>, with the pull
+        springs gamma <k> N_i along x already in the diagonal blocks of
         ``net``: the whole pull is one count (``count`` holds each node's
         slips since it began, ``L_SHIFT`` the shift U of its centre of
         mass), the stage's load f - pull U + f_bar is kept at its peak
@@ -495,7 +495,7 @@ def tilt_test_network_exact(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_
 
 @kernel_jit()
 def shs_test_network(G, mu, f_ext, f_bar, net, settings, shs_mu, pos, heaps, epoch, count, loads, pull):
-    """The slide-hold-slide pull with straight-line slips: :func:`_tilt_test` with ``pull`` = kappa <k> > 0 on
+    """The slide-hold-slide pull with straight-line slips: :func:`_tilt_test` with ``pull`` = gamma <k> > 0 on
     ``net``, whose diagonal blocks hold the pull springs (``solver.scene.shs_operators``); thresholds redrawn
     from ``shs_mu``. Returns f >= 0 at the end of the pull (its sample is ``loads[L_PEAK]``), or a code."""
     return _tilt_test(G, mu, f_ext, f_bar, net, settings, False, shs_mu, shs_mu[:0], pos, 0, heaps, epoch, count,

@@ -299,7 +299,7 @@ class Realization:
         G[:, : F.shape[1]] = F
         return getattr(self, name), G
 
-    def shs_test(self) -> tuple[float, float]:
+    def shs_test(self, mu: np.ndarray | None = None, *, advance: bool = True) -> tuple[float, float]:
         """One slide-hold-slide pull on a copy of the current state: mu_shs, and the stage's travel at the peak.
 
         A stage moving quasi-statically along +x pulls every node i through a
@@ -309,6 +309,17 @@ class Realization:
         mean f_ext along x (docs/model.md, "Slide-hold-slide";
         :mod:`slidernet.kernels.tilt_net` for the rule). The state is left as it
         was; the draws come from the realization's ``shs`` stream.
+
+        Parameters
+        ----------
+        mu : ndarray of float64, shape (N,), optional
+            The thresholds the pull starts from, which it overwrites (default:
+            a copy of the realization's, the contacts as the hold left them;
+            :meth:`tested_thresholds`).
+        advance : bool
+            True: the ``shs`` stream goes on after the draws this pull read.
+            False: it stays where it was, so that the next pull reads the same
+            draws (the injected twin of ``[tilt] inject``).
 
         Returns
         -------
@@ -322,7 +333,7 @@ class Realization:
         scene = self.scene
         o = scene.shs_operators()
         (heaps, epoch, count, pos, loads), G = self._test_work("_shs_work")
-        mu = self.mu.copy()  # the thresholds the pull starts from: the contacts as the hold left them
+        mu = self.mu.copy() if mu is None else mu
         st = self.state
         pos[:] = 0
         pos[tilt_net.P_MU] = st["shs_mu_pos"][0]
@@ -332,7 +343,8 @@ class Realization:
                          loads, o.pull)
             status = kernels.tilt_status(end)
             if status == kernels.DONE:
-                st["shs_mu_pos"] = pos[tilt_net.P_MU]
+                if advance:
+                    st["shs_mu_pos"] = pos[tilt_net.P_MU]
                 return float(loads[tilt_net.L_PEAK]), float(loads[tilt_net.L_TRAVEL] * scene.network.Ntilde)
             if status != kernels.NEED_TILT:
                 slips = int(pos[tilt_net.N_SLIPS])
@@ -431,7 +443,14 @@ class Realization:
             out["tilt_all_moving" + suffix][k] = _mean_of_events([moving for _, _, _, moving in tests])
 
     def _shs_record(self, k: int) -> None:
-        self.out["mu_shs"][k], self.out["shs_travel"][k] = self.shs_test()
+        """The slide-hold-slide pull at recorded time ``k``, after its injected twin under ``[tilt] inject``."""
+        if self.scene.inject is not None:
+            # The twin first, leaving the shs stream where it was, as the tilt test's twin does the tilt stream's.
+            try:
+                self.out["mu_shs_injected"][k], _ = self.shs_test(self.tested_thresholds(k, True), advance=False)
+            except TiltTestError as exc:
+                raise TiltTestError(f"The injected twin ([tilt] inject) of a pull: {exc}") from None
+        self.out["mu_shs"][k], self.out["shs_travel"][k] = self.shs_test(self.tested_thresholds(k, False))
 
     def _run_kernel(self, to_step: int, stop: StopCheck | None) -> bool:
         """Run the kernel to ``to_step``; False if ``stop`` asked it to stop first (see :meth:`advance`)."""
@@ -607,11 +626,14 @@ class Realization:
 
 def _more_tilt_records(scene: Scene, T: int) -> dict[str, np.ndarray]:
     """The records of ``[tilt] repeats`` (``mu_eff_spread``) and of ``[tilt] inject`` (the injected twins' sums,
-    and their loads and cap counts where the plain tests have them), shape (T,) each."""
+    and their loads and cap counts where the plain tests have them; ``mu_shs_injected`` where the pull runs),
+    shape (T,) each."""
     out: dict[str, np.ndarray] = {}
     if scene.tilt_repeats > 1:
         out["mu_eff_spread"] = np.full(T, np.nan)
-    if scene.inject is not None:
+    if scene.inject is not None and scene.shs_stiffness is not None:
+        out["mu_shs_injected"] = np.full(T, np.nan)
+    if scene.inject is not None and scene.tilt_at == "records":
         out.update(f_sum_injected=np.zeros(T), f_sq_injected=np.zeros(T), f_count_injected=np.zeros(T, np.int64))
         if scene.tilt_loads:
             out.update(tilt_first_slip_injected=np.full(T, np.nan), tilt_all_moving_injected=np.full(T, np.nan))

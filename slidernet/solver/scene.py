@@ -337,7 +337,7 @@ class Scene:
             tilt_min_shift=min_shift,
             tilt_repeats=tilt.repeats if tilt_at == "records" else 1,
             # Where a test it raises runs (Config.injected_tests, the one rule).
-            inject=tilt.inject if tilt_at == "records" and cfg.injected_tests() else None,
+            inject=tilt.inject if cfg.injected_tests() else None,
             shs_stiffness=cfg.shs_settings().stiffness if "mu_shs" in cfg.observables else None,
             operators=operators,
         )
