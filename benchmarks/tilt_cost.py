@@ -2,7 +2,7 @@
 
     python benchmarks/tilt_cost.py [--sizes 100 1000 10000] [--lattices 10 32] [--realizations 8]
                                    [--tests 2] [--age 3] [--seed 1] [--core 0] [--max-avalanche S]
-                                   [--overshoot E] [--min-slips M] [--min-displacement X]
+                                   [--overshoot E] [--min-slips M] [--min-displacement X] [--shs GAMMA]
                                    [--csv PATH] [--quick]
 
 The network tilt test (:meth:`slidernet.solver.Realization.tilt_test`, kernel
@@ -85,6 +85,15 @@ compare (the rule is printed in the first line). A configuration with a
 ``[tilt]`` table must ask for ``mu_eff``, so with ``--min-slips`` or
 ``--min-displacement`` the scenes record ``mu_eff`` at t = 0: one untimed
 test of the fresh state, which also fills part of the tilt draw buffers.
+
+``--shs GAMMA`` times the slide-hold-slide pull instead
+(:meth:`slidernet.solver.Realization.shs_test`, the observable ``mu_shs``
+with ``[shs] stiffness = GAMMA``): the same body as the tilt test, pulled
+through springs until every node has slipped. Its scenes record ``mu_shs``
+at t = 0 (one untimed pull) and run to ``--age`` + 1 steps, so that no
+timed thermal step holds a pull; its slips are counted from the ``shs``
+draws as the test's are from the tilt draws, and its result, ``mu_shs``,
+stands in the column of mu_eff.
 """
 
 from __future__ import annotations
@@ -149,7 +158,9 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None,
         ``solver.max_avalanche`` (also the tilt test's cap on slips); None: the default.
     rule : dict, optional
         ``overshoot``, ``min_slips``, ``min_displacement`` (any of them; None
-        values left out): ``friction.overshoot`` and the ``[tilt]`` table.
+        values left out): ``friction.overshoot`` and the ``[tilt]`` table;
+        ``shs``: the slide-hold-slide pull's stiffness (its observable, and
+        ``age`` + 1 steps).
 
     Returns
     -------
@@ -164,6 +175,9 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None,
     if max_avalanche is not None:
         cfg["solver"] = {"max_avalanche": max_avalanche}
     rule = {k: v for k, v in (rule or {}).items() if v is not None}
+    if "shs" in rule:
+        # A pull at t = 0 only (untimed); the last recorded time, always one, after the timed steps.
+        cfg.update(observables=["n", "mu_shs"], shs={"stiffness": rule.pop("shs")}, steps=age + 1, record=[0])
     if "overshoot" in rule:
         cfg["friction"] = FRICTION | {"overshoot": rule.pop("overshoot")}
     if rule:
@@ -176,25 +190,30 @@ def run_config(network: dict[str, Any], age: int, max_avalanche: int | None,
 
 
 def warm_up() -> None:
-    """Load the compiled kernels (thermal steps and tilt test) on tiny scenes of both kinds, untimed."""
+    """Load the compiled kernels (thermal steps, tilt test, pull) on tiny scenes of both kinds, untimed."""
     for network in (network_table("irregular", 16), network_table("triangular", 4)):
-        real = Realization(Scene.from_config(load_config(run_config(network, 2, None))), np.random.SeedSequence(0))
+        real = Realization(Scene.from_config(load_config(run_config(network, 2, None, {"shs": 1.0}))),
+                           np.random.SeedSequence(0))
         real.advance(2)
         real.tilt_test()
+        real.shs_test()
 
 
-def _tilt_read(real: Realization) -> tuple[np.ndarray, int]:
-    """The tilt stream's threshold buffer and the read position in it (public attributes)."""
-    return real.buffers.tilt_mu, int(real.state["tilt_mu_pos"][0])
+def _tilt_read(real: Realization, shs: bool = False) -> tuple[np.ndarray, int]:
+    """The tilt (or shs) stream's threshold buffer and the read position in it (public attributes)."""
+    name = "shs_mu" if shs else "tilt_mu"
+    return getattr(real.buffers, name), int(real.state[f"{name}_pos"][0])
 
 
-def timed_test(real: Realization) -> dict[str, Any]:
-    """One tilt test of ``real``'s state, timed.
+def timed_test(real: Realization, shs: bool = False) -> dict[str, Any]:
+    """One tilt test of ``real``'s state, timed (with ``shs``, one slide-hold-slide pull).
 
     Parameters
     ----------
     real : Realization
         The realization; its state is left as it was.
+    shs : bool
+        Time :meth:`Realization.shs_test` instead; its ``mu_shs`` is returned as ``mu_eff``.
 
     Returns
     -------
@@ -212,15 +231,15 @@ def timed_test(real: Realization) -> dict[str, Any]:
     that ran out of draws got a new buffer (from the test's first draw on,
     then new draws), read from 0.
     """
-    buf0, pos0 = _tilt_read(real)
+    buf0, pos0 = _tilt_read(real, shs)
     c0, t0 = time.process_time(), time.perf_counter()
     try:
-        mu_eff = real.tilt_test()
+        mu_eff = real.shs_test()[0] if shs else real.tilt_test()
     except TiltTestError:
         seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
         return {"seconds": seconds, "cpu": cpu, "mu_eff": math.nan, "slips": 0, "slid": False, "refilled": True}
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
-    buf1, pos1 = _tilt_read(real)
+    buf1, pos1 = _tilt_read(real, shs)
     refilled = buf1 is not buf0  # a refill gives a new buffer, read from 0
     read = pos1 if refilled else pos1 - pos0
     return {"seconds": seconds, "cpu": cpu, "mu_eff": mu_eff, "slips": read + 1, "slid": True,
@@ -282,7 +301,7 @@ def measure(kind: str, size: int, realizations: int, tests: int, age: int, seed:
             t1 = time.perf_counter()
             real.advance(q)
             steps.append(time.perf_counter() - t1)
-        done = [timed_test(real) for _ in range(tests)]
+        done = [timed_test(real, (rule or {}).get("shs") is not None) for _ in range(tests)]
         wall += sum(d["seconds"] for d in done)
         cpu += sum(d["cpu"] for d in done)
         slid = [d for d in done if d["slid"]]
@@ -535,6 +554,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--overshoot", type=float, default=None, help="friction.overshoot e in [0, 1] (default 1)")
     ap.add_argument("--min-slips", type=int, default=None, help="[tilt] min_slips (default 1)")
     ap.add_argument("--min-displacement", type=float, default=None, help="[tilt] min_displacement (default 0)")
+    ap.add_argument("--shs", type=float, default=None, metavar="GAMMA",
+                    help="time the slide-hold-slide pull with [shs] stiffness = GAMMA instead of the tilt test")
     ap.add_argument("--csv", type=Path, default=None, help="also write the rows to this CSV file")
     ap.add_argument("--quick", action="store_true", help="a smoke run of a few seconds")
     args = ap.parse_args(argv)
@@ -547,12 +568,14 @@ def main(argv: list[str] | None = None) -> int:
     if age < 2 or tests < 1 or realizations < 1:
         ap.error("--age must be at least 2, --tests and --realizations at least 1")
 
-    rule = {"overshoot": args.overshoot, "min_slips": args.min_slips, "min_displacement": args.min_displacement}
+    rule = {"overshoot": args.overshoot, "min_slips": args.min_slips, "min_displacement": args.min_displacement,
+            "shs": args.shs}
     load_config(run_config(network_table("irregular", 16), 2, None, rule))  # a bad rule: one line, before work
     core = _pick_core(args.core)
     t_start = time.perf_counter()
     named = ", ".join(f"{k} = {v:g}" for k, v in rule.items() if v is not None) or "the defaults"
-    print(f"network tilt test, cost per test; rule: {named}; one core = core {core}; load average "
+    what = "slide-hold-slide pull" if args.shs is not None else "network tilt test"
+    print(f"{what}, cost per test; rule: {named}; one core = core {core}; load average "
           f"{os.getloadavg()[0]:.2f}", flush=True)
     warm_up()
     rows = []

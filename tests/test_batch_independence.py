@@ -117,17 +117,18 @@ def test_the_users_case_no_longer_depends_on_the_batch() -> None:
 
 def test_the_documented_stream_order(empirical_file: Path) -> None:
     # Realization's docstring: thresholds and tilt thresholds are TruncatedStreams on
-    # their Generators, the tilt uniforms plain random() on the first child of the tilt child.
+    # their Generators, the tilt uniforms plain random() on the first child of the tilt child,
+    # the slide-hold-slide thresholds on the fourth child.
     law = law_spec("uniform", empirical_file)
     scene = Scene.from_config(load_config(config(law, {"kind": "two_slider"}, steps=5, batch=7)))
     ss = np.random.SeedSequence(12)
     real = Realization(scene, ss)
     rngs = realization_streams(ss)
-    assert sorted(rngs) == ["driver", "thresholds", "tilt", "tilt_uniforms"]
-    children = np.random.SeedSequence(12).spawn(3)
+    assert sorted(rngs) == ["driver", "shs", "thresholds", "tilt", "tilt_uniforms"]
+    children = np.random.SeedSequence(12).spawn(4)
     uniforms = np.random.Generator(np.random.PCG64(np.random.SeedSequence(12, spawn_key=(2, 0))))
     assert uniforms.bit_generator.state == rngs["tilt_uniforms"].bit_generator.state
-    for name, child in zip(("driver", "thresholds", "tilt"), children, strict=True):
+    for name, child in zip(("driver", "thresholds", "tilt", "shs"), children, strict=True):
         assert np.random.Generator(np.random.PCG64(child)).bit_generator.state == rngs[name].bit_generator.state
     thresholds = TruncatedStream(scene.distribution, rngs["thresholds"]).take(2 + 7)
     np.testing.assert_array_equal(np.concatenate([real.mu, real.buffers.mu]), thresholds, strict=True)

@@ -231,8 +231,8 @@ def test_files_that_are_not_checkpoints_are_refused(tmp_path: Path) -> None:
     arrays = npz_arrays(tmp_path / "r.npz")
     del arrays["surplus/thresholds"]
     np.savez(tmp_path / "no_surplus.npz", **arrays)
-    with pytest.raises(CheckpointError, match=r"inconsistent: its threshold streams are \['tilt'\], "
-                                              r"a realization's are \['thresholds', 'tilt'\]"):
+    with pytest.raises(CheckpointError, match=r"inconsistent: its threshold streams are \['shs', 'tilt'\], "
+                                              r"a realization's are \['shs', 'thresholds', 'tilt'\]"):
         load_realization(scene, ss, tmp_path / "no_surplus.npz")
     arrays = npz_arrays(tmp_path / "r.npz")
     arrays["surplus/tilt"] = np.array([0.6, 0.4])

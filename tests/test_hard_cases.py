@@ -660,7 +660,7 @@ def valid_runs(draw: Callable) -> dict[str, Any]:
         static = {"name": "uniform", "low": mu_d - gap * draw(st.floats(0.0, 1.0)), "high": mu_d + 2 * gap}
     slips = 10 ** draw(st.floats(-2.0, 4.0 if kind == "two_slider" else 2.5))
     ratio = slips * math.sqrt(math.pi) * gap + mu_d
-    extra = draw(st.lists(st.sampled_from(["mu_eff", "n_records", "events"]), unique=True))
+    extra = draw(st.lists(st.sampled_from(["mu_eff", "n_records", "events", "mu_shs"]), unique=True))
     return {
         "seed": draw(st.integers(0, 2**32 - 1)),
         "realizations": draw(st.integers(1, 3)),

@@ -26,12 +26,13 @@ from slidernet.solver.snapshot import check_fingerprint, scene_fingerprint
 
 from .conftest import make_config
 
-OBSERVED = ["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "contact_age"]
+OBSERVED = ["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "contact_age", "mu_shs"]
 
 #: The plain variables of a run with the network tilt test, and their injected twins.
 TWINS = {"mu_eff": "mu_eff_injected", "mu_eff_sem": "mu_eff_injected_sem", "mu_eff_count": "mu_eff_injected_count",
          "mu_eff_realization": "mu_eff_injected_realization", "tilt_first_slip": "tilt_first_slip_injected",
-         "tilt_all_moving": "tilt_all_moving_injected", "tilt_capped": "tilt_capped_injected"}
+         "tilt_all_moving": "tilt_all_moving_injected", "tilt_capped": "tilt_capped_injected",
+         "mu_shs": "mu_shs_injected", "mu_shs_mean": "mu_shs_injected_mean", "mu_shs_sem": "mu_shs_injected_sem"}
 
 
 def _graph(tmp_path: Path) -> dict[str, Any]:
@@ -79,7 +80,7 @@ def test_c_0_changes_no_bit_and_its_twins_equal_the_plain_outputs(scene, select,
     for name in plain.data_vars:
         np.testing.assert_array_equal(injected[name].values, plain[name].values, err_msg=name)
     twins = [(p, i) for p, i in TWINS.items() if p in plain]
-    assert len(twins) >= 6
+    assert len(twins) >= 9
     for p, i in twins:
         assert injected[i].dtype == plain[p].dtype, i
         np.testing.assert_array_equal(injected[i].values, plain[p].values, err_msg=i)
@@ -95,6 +96,7 @@ def test_an_injection_never_changes_the_run(scene, select, tmp_path):
         np.testing.assert_array_equal(injected[name].values, plain[name].values, err_msg=name)
     assert not np.array_equal(injected["tilt_first_slip_injected"].values[:, 1:],
                               plain["tilt_first_slip"].values[:, 1:])
+    assert not np.array_equal(injected["mu_shs_injected"].values[:, 1:], plain["mu_shs"].values[:, 1:])
 
 
 @pytest.mark.parametrize("scene", ["chain-overshoot-0", "irregular-min_slips-repeats"])
@@ -288,11 +290,11 @@ def test_each_repeat_has_its_injected_twin():
 
 REFUSED = {
     "inject-without-mu_eff": ({"tilt": {"inject": {"c": 0.01}}, "observables": ["n"]},
-                              r"'tilt\.inject' raises the thresholds .* this run makes no such test: "
-                              r"\"mu_eff\" is not in 'observables'; add it"),
+                              r"'tilt\.inject' raises the thresholds .* this run makes neither: "
+                              r"\"mu_eff\" is not in 'observables'; add it, or add \"mu_shs\""),
     "inject-with-the-appendix-test": ({"tilt": {"inject": {"c": 0.01}}},
                                       r"'tilt\.inject' .* the appendix's test of two sliders before every "
-                                      r"rearrangement; set 'mu_eff_at = \"records\"'"),
+                                      r"rearrangement; set 'mu_eff_at = \"records\"', or add \"mu_shs\""),
     "repeats-without-mu_eff": ({"tilt": {"repeats": 2}, "observables": ["n"], "mu_eff_at": "records"},
                                r"'tilt\.repeats' = 2 asks for that many network tilt tests .* \"mu_eff\" is not "
                                r"in 'observables'; add it"),

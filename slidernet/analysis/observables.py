@@ -44,13 +44,19 @@ ATTRS = {
                                  "evolution (since t = 0 for a node that has not slipped)", "units": "tau_th"},
     "mu_eff_realization": {"long_name": "mean of the realization's own tilt tests in the bin (t_{k-1}, t_k] "
                                         "(NaN: none)", "units": "1"},
+    "mu_shs": {"long_name": "static friction from the slide-hold-slide pull at t: peak of the stage force per "
+                            "unit normal load, plus f_bar, until every contact was renewed (NaN: no pull, the "
+                            "network had slid away)", "units": "1"},
+    "shs_travel": {"long_name": "travel of the slide-hold-slide stage from the start of its pull at t to the peak "
+                                "of mu_shs", "units": "l0"},
     "tilt_capped": {"long_name": "number of network tilt tests at t, over the realizations, that met the "
                                 "avalanche cap (a part of the network sliding alone) before the sliding rule of "
                                 "[tilt]: left out of mu_eff and mu_eff_count", "units": "1"},
 }
 
 #: The pairing every injected variable rests on, in its attributes with the injection's c, t0 and select.
-PAIRING = ("each test at t is made twice, on the same state with the same draws of the tilt stream: as it is "
+PAIRING = ("each test at t is made twice, on the same state with the same draws of its stream (tilt; shs for the "
+           "slide-hold-slide pull): as it is "
            "(the plain variable) and on a copy whose thresholds mu_s are raised by "
            "inject_c ln(1 + t / inject_t0), those of the ceil(inject_select N) oldest contacts (all with "
            "inject_select = 1); a contact that slips in the test draws a fresh threshold without the rise")
@@ -192,14 +198,14 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     inject = records[0].get("inject")
     for suffix in ("", "_injected") if inject is not None else ("",):
         attrs = (lambda name: ATTRS[name]) if not suffix else (lambda name: _injected_attrs(name, inject))
-        if "mu_eff_realization" in observables:
+        if "mu_eff_realization" in observables and "f_count" + suffix in records[0]:
             # Each realization's own mean of its tilt tests in the bin: independent across realizations,
             # so trends and errors of mu_eff can come from the spread of realizations, not of time bins.
             count = np.stack([r["f_count" + suffix] for r in records]).astype(np.float64)
             with np.errstate(invalid="ignore", divide="ignore"):
                 value = np.stack([r["f_sum" + suffix] for r in records]) / np.where(count > 0, count, np.nan)
             out[f"mu_eff{suffix}_realization"] = (("realization", "t"), value, attrs("mu_eff_realization"))
-        for name in ("tilt_first_slip", "tilt_all_moving"):
+        for name in ("tilt_first_slip", "tilt_all_moving", "mu_shs", "shs_travel"):
             if name + suffix in records[0]:
                 out[name + suffix] = (("realization", "t"), np.stack([r[name + suffix] for r in records]),
                                       attrs(name))
@@ -250,7 +256,9 @@ class EnsembleStats:
         The last recorded time, for the rate ``r = n(steps) / steps``.
     """
 
-    MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age")
+    MOMENTS = ("n", "mu_max", "x_G", "n_records", "contact_age", "mu_shs")
+    #: Of those, the ones an injected twin of ``[tilt] inject`` has, named ``<name>_injected`` in the records.
+    INJECTED_MOMENTS = ("mu_shs",)
 
     def __init__(self, observables: list[str], steps: int) -> None:
         self.observables = list(observables)
@@ -285,6 +293,8 @@ class EnsembleStats:
                 self._merge(name, x)
                 if name == "x_G":
                     self._merge("x_G2", x**2)
+            if name in self.INJECTED_MOMENTS and name + "_injected" in records[0]:
+                self._merge(name + "_injected", np.stack([r[name + "_injected"] for r in records]).astype(float))
         if "n" in self.observables and self.steps > 0:
             self._merge("r", np.array([[r["n"][-1] / self.steps] for r in records]))
         if "contact_age" in self.observables:
@@ -339,6 +349,12 @@ class EnsembleStats:
                 mean, sem = self._mean_sem("x_G2")
                 out["x_G2_mean"] = ("t", mean, {"long_name": "mean square displacement <x_G^2>", "units": "l0^2"})
                 out["x_G2_sem"] = ("t", sem, {"long_name": "standard error of x_G2_mean", "units": "l0^2"})
+            if name + "_injected" in self._moments:
+                twin = f"{name}_injected"
+                extra = {**_injected_attrs(name, self._inject), "long_name": f"ensemble mean of {twin}"}
+                mean, sem = self._mean_sem(twin)
+                out[f"{twin}_mean"] = ("t", mean, extra)
+                out[f"{twin}_sem"] = ("t", sem, {**extra, "long_name": f"standard error of {twin}_mean"})
         if self._age_count is not None:
             out["contact_age_count"] = (("t", "contact_age_bin"), self._age_count, {
                 "long_name": "number of (realization, node) pairs whose contact age at t lies in the bin "

@@ -16,7 +16,8 @@ From the bottom up (each module imports only those above it in this list):
   (:func:`build_distribution`);
 - :mod:`~slidernet.config.network`, :mod:`~slidernet.config.units`,
   :mod:`~slidernet.config.solver`, :mod:`~slidernet.config.execution`,
-  :mod:`~slidernet.config.creep`, :mod:`~slidernet.config.tilt`: one table each;
+  :mod:`~slidernet.config.creep`, :mod:`~slidernet.config.tilt`,
+  :mod:`~slidernet.config.shs`: one table each;
 - :mod:`~slidernet.config.run`: :class:`Config`, the whole run, and the
   names of the observables;
 - :mod:`~slidernet.config.loading`: :func:`load_config`, :func:`read_toml`,
@@ -55,12 +56,13 @@ from slidernet.config.plugins import (
 )
 from slidernet.config.rules import PAIR_TILT_ONLY, choose_kernel, choose_tilt_at
 from slidernet.config.run import NETWORK_OBSERVABLES, OBSERVABLES, Config, Observable
+from slidernet.config.shs import ShsConfig
 from slidernet.config.solver import SolverConfig
 from slidernet.config.tilt import InjectConfig, TiltConfig
 from slidernet.config.units import UnitsConfig
 
 __all__ = ["NETWORK_OBSERVABLES", "OBSERVABLES", "PAIR_TILT_ONLY", "SCHEDULER_REQUIREMENT", "Config",
            "CreepConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig", "NetworkConfig",
-           "Observable", "PluginSpec", "PositiveFloat", "SolverConfig", "StrengtheningConfig", "TiltConfig",
-           "UnitsConfig", "build_distribution", "build_network",
+           "Observable", "PluginSpec", "PositiveFloat", "ShsConfig", "SolverConfig", "StrengtheningConfig",
+           "TiltConfig", "UnitsConfig", "build_distribution", "build_network",
            "choose_kernel", "choose_tilt_at", "is_finite", "is_scheduler_address", "load_config", "read_toml"]

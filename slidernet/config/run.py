@@ -25,6 +25,7 @@ from slidernet.config.plugins import (
     build_distribution,
 )
 from slidernet.config.rules import choose_kernel, choose_tilt_at
+from slidernet.config.shs import ShsConfig
 from slidernet.config.solver import SolverConfig
 from slidernet.config.tilt import TiltConfig
 from slidernet.config.units import _UNITS_RTOL, UnitsConfig, _fill_from_units
@@ -34,12 +35,12 @@ from slidernet.plugins import registry
 from slidernet.plugins.distributions import TruncatedBelow
 
 OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
-               "creep", "contact_age")
+               "creep", "contact_age", "mu_shs")
 
 #: Observables only the network kernels record (always, asked for or not); ``y_G`` in 2D only.
 NETWORK_OBSERVABLES = ("y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s")
 Observable = Literal["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
-                     "creep", "contact_age",
+                     "creep", "contact_age", "mu_shs",
                      "y_G", "mu_mean", "mu_min", "avalanche_count", "node_slips", "mu_s"]
 
 
@@ -59,7 +60,7 @@ class Config(_Strict):
 
     # "plugins" too: a configuration without it dumps as it did before the key existed, so that
     # stored results and interrupted runs (run.json) still match it.
-    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt")
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt", "shs")
 
     seed: Seed | None = Field(
         None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
@@ -96,6 +97,9 @@ class Config(_Strict):
     creep: CreepConfig | None = Field(
         None, description="Parameters of the observable 'creep' (the reptation velocity and the creep events); "
                           "None: the defaults. Refused without that observable.")
+    shs: ShsConfig | None = Field(
+        None, description="The pull springs of the slide-hold-slide protocol (observable 'mu_shs'); None: the "
+                          "defaults. Refused without that observable.")
     plugins: list[Annotated[str, Field(min_length=1)]] | None = Field(
         None, description="Python files (ending in .py; a relative path is relative to the configuration file) "
                           "or dotted module names that register plugins when imported "
@@ -182,6 +186,9 @@ class Config(_Strict):
             raise ValueError("'friction.overshoot' sets the length of a straight-line slip, and 'solver.slip = "
                              "\"exact\"' integrates the undamped 2D motion, whose overshoot is 1; use one or the "
                              "other")
+        if self.shs is not None and "mu_shs" not in self.observables:
+            raise ValueError("the [shs] table sets the slide-hold-slide pull of the observable 'mu_shs', which is "
+                             "not asked for; add \"mu_shs\" to 'observables' or remove the table")
         if self.creep is not None and "creep" not in self.observables:
             raise ValueError("the [creep] table sets the observable 'creep', which is not asked for; "
                              "add \"creep\" to 'observables' or remove the table")
@@ -206,9 +213,10 @@ class Config(_Strict):
             raise ValueError(f"'tilt.repeats' = {tilt.repeats} asks for that many network tilt tests of 'mu_eff' "
                              f"at each recorded time, and this run makes none: {missing}")
         if tilt.inject is not None and not self.injected_tests():
-            raise ValueError("'tilt.inject' raises the thresholds of the copy that the network tilt test of "
-                             "'mu_eff' measures at the recorded times, and this run makes no such test: "
-                             f"{missing}")
+            raise ValueError("'tilt.inject' raises the thresholds of the copy that a test of static friction "
+                             "measures at the recorded times (the network tilt test of 'mu_eff', the "
+                             "slide-hold-slide pull of 'mu_shs'), and this run makes neither: "
+                             f"{missing}, or add \"mu_shs\" to 'observables'")
         if self.injects_by_age() and self.solver.kernel == "pair":
             raise ValueError("'tilt.inject' with select < 1 raises the oldest contacts, whose ages need a network "
                              "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
@@ -225,10 +233,12 @@ class Config(_Strict):
     def injected_tests(self) -> list[str]:
         """The observables whose tests ``[tilt] inject`` raises in this run (the one place of that rule).
 
-        The network tilt test of ``mu_eff`` at the recorded times; an
+        The network tilt test of ``mu_eff`` at the recorded times, and the
+        slide-hold-slide pull of ``mu_shs``: each alone, or both; an
         injection with none of them is refused.
         """
-        return ["mu_eff"] if self._no_network_tilt_test() is None else []
+        return ([name for name, runs in (("mu_eff", self._no_network_tilt_test() is None),
+                                         ("mu_shs", "mu_shs" in self.observables)) if runs])
 
     @model_validator(mode="after")
     def _network_observables_can_be_recorded(self) -> Config:
@@ -286,6 +296,10 @@ class Config(_Strict):
     def tilt_settings(self) -> TiltConfig:
         """The [tilt] table, or its defaults where it is not given."""
         return self.tilt if self.tilt is not None else TiltConfig()
+
+    def shs_settings(self) -> ShsConfig:
+        """The [shs] table, or its defaults where it is not given."""
+        return self.shs if self.shs is not None else ShsConfig()
 
     def creep_settings(self) -> CreepConfig:
         """The [creep] table, or its defaults where it is not given."""

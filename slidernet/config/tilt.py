@@ -38,8 +38,11 @@ class InjectConfig(_Strict):
     fresh threshold and keeps no shift. The run itself (its state, its
     streams, every other record) is never touched: the paired difference is
     the estimator's response to a known rise of the thresholds, with common
-    random numbers. The result gains ``mu_eff_injected`` and the other
-    ``*_injected`` variables (docs/model.md, "Injected aging").
+    random numbers. The tests are the network tilt test of ``mu_eff`` and the
+    slide-hold-slide pull of ``mu_shs``, each where the run makes it (the
+    pull alone is enough). The result gains ``mu_eff_injected``,
+    ``mu_shs_injected`` and the other ``*_injected`` variables
+    (docs/model.md, "Injected aging").
     """
 
     c: NonNegativeFloat = Field(
@@ -95,8 +98,9 @@ class TiltConfig(_Strict):
     ``repeats = K`` makes K independent tests at each recorded time, one
     after the other from the tilt stream, the first of them the test of a
     run without the key; ``inject`` adds an injected twin to each test
-    (:class:`InjectConfig`). Both need the network tilt test of ``mu_eff``
-    at the recorded times.
+    (:class:`InjectConfig`), and to the slide-hold-slide pull of
+    ``mu_shs``. ``repeats`` needs the network tilt test of ``mu_eff`` at
+    the recorded times; ``inject`` that test or the pull.
     """
 
     # Left out of a dump when not given, so that a table without them keeps its identity (config/base.py).
@@ -115,7 +119,8 @@ class TiltConfig(_Strict):
                        "mu_eff_realization is their mean, mu_eff_spread their standard deviation.")
     inject: InjectConfig | None = Field(
         None, description="A known aging injected into the tested copy of the state, tested beside every test "
-                          "(None: none).")
+                          "at the recorded times: the network tilt test of mu_eff and the slide-hold-slide "
+                          "pull of mu_shs (None: none).")
 
     def is_default(self) -> bool:
         """True if the sliding rule is that of every earlier result (``repeats`` and ``inject`` aside)."""

@@ -81,6 +81,7 @@ STATE = np.dtype([
     ("mu_pos", np.int64),
     ("tilt_mu_pos", np.int64),
     ("tilt_u_pos", np.int64),
+    ("shs_mu_pos", np.int64),  # read by the slide-hold-slide pull only (Python calls it; no kernel of the run)
     # avalanches
     ("av_slips", np.int64),  # slips of the current avalanche after its driving slip
     ("in_avalanche", np.int64),  # 1 between a driving slip and the end of its avalanche
@@ -198,6 +199,8 @@ class Draws(NamedTuple):
     mu: np.ndarray  # thresholds mu_s handed out one per slip
     tilt_mu: np.ndarray  # thresholds redrawn by the appendix's tilt test
     tilt_u: np.ndarray  # uniforms in [0, 1) of the tilt test's creep branch
+    # thresholds redrawn by the slide-hold-slide pull (observable mu_shs; 0-length without it)
+    shs_mu: np.ndarray = np.empty(0)
 
 
 class Series(NamedTuple):

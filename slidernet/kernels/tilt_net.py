@@ -1,4 +1,5 @@
-"""The virtual tilt test of a whole network (docs/model.md section 1, generalized to N sliders).
+"""The virtual tilt test of a whole network (docs/model.md section 1, generalized to N sliders), and the
+slide-hold-slide pull, its variant.
 
 On a copy of the state, a tangential force f N_i along +x (a tilt by tan(alpha)
 = f) is added to every node and f is raised quasi-statically:
@@ -59,6 +60,17 @@ mu_s,old - 2 mu_d after its slip does (it is unstable). With another slip
 rule (``friction.overshoot`` e < 1) the pair's test is the appendix's with
 that slip, as :func:`slidernet.kernels.tilt.tilt_test_pair` makes it.
 
+**Slide-hold-slide** (:func:`shs_test_network`, docs/model.md "Slide-hold-slide") is the same body
+with ``pull`` = gamma <k> > 0: a stage at X along +x is joined to every node i by a spring of stiffness
+gamma N_i <k>, so node i feels G_i + gamma N_i <k> (X - u_i,x) x, u_i its displacement since the pull
+began. That is the tilt f N_i above with f = gamma <k> X, on a network whose diagonal blocks K_ii hold
+the pull spring gamma N_i <k> along x (the caller's ``net``): the critical f, the slips (with the local
+stiffness pull spring included), the avalanches and the redraws are the tilt test's. Every slip relaxes
+a pull spring, so every avalanche at fixed X ends: no rule 3 or 4. The stage force per unit normal load,
+F / sum N = f - gamma <k> U (U = sum_i N_i u_i,x / sum N), rises with f between slips and drops at each
+forward slip; its peak plus f_bar is the sample ``loads[L_PEAK]``, and the pull ends at the slip that
+renews the last contact: every node has slipped at least once since it began.
+
 Work arrays are the caller's: two :class:`~slidernet.kernels.state.Heaps`
 over the N nodes (``Heaps.empty(2, N)``), ``epoch`` and ``count`` (N,) int64, so that a
 test allocates nothing.
@@ -85,7 +97,8 @@ S_EP = 6  # the current avalanche (see ``epoch``)
 S_MOVING = 7  # nodes in motion in the current avalanche: slipped at least once, or unstable (rule 3)
 S_DONE = 8  # nodes that meet the sliding rule's tilt.min_slips (``_in_motion`` with m)
 S_AV = 9  # slips of the current avalanche (rule 4)
-N_POS = 10
+S_RENEWED = 10  # slide-hold-slide: nodes that have slipped since the pull began
+N_POS = 11
 
 # Where a test that ran out of draws resumes (``pos[STAGE]``).
 R_REDRAW = 1  # redraw the threshold of node pos[S_NODE], which has just slipped
@@ -104,7 +117,10 @@ L_FIRST = 0  # at the test's first slip (the first critical f)
 L_MOVING = 1  # when an avalanche first set every node in motion at once, whatever its relation to mu_d
 L_F = 2  # the tilt f reached so far: where a test resumes, and the load of a test that gave up
 L_SHIFT = 3  # not a load: the current avalanche's displacement of the centre of mass along x, Ntilde l0
-N_LOADS = 4
+#              (slide-hold-slide: since the pull began)
+L_PEAK = 4  # slide-hold-slide: the largest stage load so far, F / sum N + f_bar (the sample, mu_shs)
+L_TRAVEL = 5  # slide-hold-slide: not a load: the stage's travel X at that peak, Ntilde l0
+N_LOADS = 6
 
 # The test's two heaps.
 _UNSTABLE = 0  # unstable nodes keyed by overload
@@ -174,10 +190,21 @@ def _in_motion(c, m, unstable):
     return c >= m or (c == m - 1 and unstable)
 
 
+@kernel_jit(forceinline=True)
+def _stage_peak(loads, f, f_bar, pull, shift):
+    """Slide-hold-slide: keep the stage's load f - pull U + f_bar (U = ``shift``) and its travel f / pull if it
+    is the largest so far (the first value replaces the NaN of a new pull)."""
+    load = f - pull * shift + f_bar
+    if not load <= loads[L_PEAK]:
+        loads[L_PEAK] = load
+        loads[L_TRAVEL] = f / pull
+
+
 @kernel_jit(inline="always")
 def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch, count,
-               loads, slip):
-    """Raise a uniform tilt on a copy of a network until it slides as a whole.
+               loads, slip, pull):
+    """Raise a uniform tilt on a copy of a network until it slides as a whole (``pull`` = 0), or pull it through
+    springs until every contact is renewed (slide-hold-slide, ``pull`` > 0).
 
     Parameters
     ----------
@@ -222,6 +249,19 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         ``epoch[j]`` (the sliding rule of ``settings.tilt_min_slips``).
     slip : compiled function
         The slip rule, ``slip(net, settings, i, Fx, Fy, norm, mag) -> (ok, du_x, du_y)``.
+    pull : float
+        0.0: the tilt test (a constant of its compiled variants, so that the
+        pull's branches fold away there). > 0: the slide-hold-slide pull
+        (:func:`shs_test_network`), ``pull`` = gamma <k>, with the pull
+        springs gamma <k> N_i along x already in the diagonal blocks of
+        ``net``: the whole pull is one count (``count`` holds each node's
+        slips since it began, ``L_SHIFT`` the shift U of its centre of
+        mass), the stage's load f - pull U + f_bar is kept at its peak
+        (``L_PEAK``, the travel f / pull in ``L_TRAVEL``), and the pull ends
+        at the slip that renews the last contact (no threshold drawn; f and U
+        at the end left in ``L_F`` and ``L_SHIFT``), with
+        none of rules 3 and 4 (``pair_rule`` and ``av_cap`` are not read;
+        ``L_FIRST`` and ``L_MOVING`` stay NaN).
     loads : ndarray of float64, shape (N_LOADS,)
         Out: the load f + f_bar at the test's first slip (``L_FIRST``), and
         when an avalanche first set every node in motion at once, above mu_d
@@ -233,7 +273,9 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
     Returns
     -------
     float
-        f + f_bar when the network slides (a mu_eff sample); ``TILT_TOO_LONG``
+        f + f_bar when the network slides (a mu_eff sample; with ``pull`` > 0,
+        f >= 0 at the end of the pull, whose sample is ``loads[L_PEAK]``:
+        a peak may have any sign and must not be read as a code); ``TILT_TOO_LONG``
         if the test gave up (``pos[STOP]`` says why); ``TILT_NEED_DRAWS`` if a
         buffer ran out. The test then stands where it stopped, in ``G``,
         ``mu``, ``heaps``, ``epoch``, ``loads`` and ``pos``: called again with
@@ -255,11 +297,15 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         f = 0.0
         loads[L_FIRST] = math.nan
         loads[L_MOVING] = math.nan
+        loads[L_PEAK] = math.nan
+        loads[L_TRAVEL] = math.nan
         for j in range(N):
             _key(j, f, G, mu, normal_load, heaps)
             epoch[j] = -1
-        ep = 0
+        # The pull is one count from its start: ep = 1 throughout (the tilt test's first avalanche is 1).
+        ep = 1 if pull > 0.0 else 0
         slips = 0
+        renewed = 0
         # moving: nodes in motion in the current avalanche (slipped, or unstable: before any slip, the
         # unstable ones); done: nodes that meet the sliding rule of m slips (the same as moving for m = 1).
         moving = heaps.size[_UNSTABLE]
@@ -276,6 +322,8 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         moving = pos[S_MOVING]
         done = pos[S_DONE]
         av_slips = pos[S_AV]
+        # Read only by a pull: in the tilt test's variants renewed stays the constant 0, no register held for it.
+        renewed = pos[S_RENEWED] if pull > 0.0 else 0
     pos[STOP] = 0
     while True:
         # What the last slip left to do, each step first checking that its draws are there:
@@ -283,12 +331,12 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         if stage == R_CREEP:
             if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
                 return _wait_for_draws(pos, loads, R_CREEP, p_mu, p_u, f, i, ep, slips, moving, done, av_slips,
-                                       shift)
+                                       shift, renewed)
             p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
         elif stage == R_REDRAW:
             if p_mu + 1 > tilt_mu.size:
                 return _wait_for_draws(pos, loads, R_REDRAW, p_mu, p_u, f, i, ep, slips, moving, done, av_slips,
-                                       shift)
+                                       shift, renewed)
             mu[i] = tilt_mu[p_mu]
             p_mu += 1
             now = _key(i, f, G, mu, normal_load, heaps)
@@ -305,11 +353,16 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             i = heaps.node[_CRITICAL, 0]
             if ep == 0:
                 loads[L_FIRST] = f + f_bar
-            ep += 1
-            moving = 0
-            done = 0
-            shift = 0.0
-            av_slips = 0
+            if pull > 0.0:
+                # The stage force has risen with f since the last slip, and this slip lowers it: a peak. The
+                # pull is one count, its shift the centre of mass's since it began.
+                _stage_peak(loads, f, f_bar, pull, shift)
+            else:
+                ep += 1
+                moving = 0
+                done = 0
+                shift = 0.0
+                av_slips = 0
         else:
             i = heaps.node[_UNSTABLE, 0]
         slips += 1
@@ -318,13 +371,15 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         # loads[L_F] is written where the test returns (f changes only just above, at a driving slip).
         if slips > settings.max_slips:
             return _give_up(pos, loads, f, STOP_SLIPS)
-        if av_slips > av_cap:
+        if pull == 0.0 and av_slips > av_cap:
             if f + f_bar > settings.mu_d:
                 pos[STOP] = STOP_CAP  # a sample, not of the sliding rule: the caller decides what it is worth
                 return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
             return _give_up(pos, loads, f, STOP_PART)
         # Node i's count goes up by one; until its threshold is redrawn it counts as stable.
         c = count[i] if epoch[i] == ep else 0
+        if pull > 0.0 and c == 0:
+            renewed += 1
         was = heaps.slot[i, _UNSTABLE] >= 0
         moving += int(_in_motion(c + 1, 1, False)) - int(_in_motion(c, 1, was))
         done += int(_in_motion(c + 1, m, False)) - int(_in_motion(c, m, was))
@@ -347,6 +402,16 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             if cj == m - 1:
                 done += int(now) - int(was)
         stage = R_REDRAW
+        if pull > 0.0:
+            # At a fixed stage a slip lowers its force, unless the node slipped backwards (2D, or a force
+            # along -x): the peak is looked for after every slip too.
+            _stage_peak(loads, f, f_bar, pull, shift)
+            if renewed == N:
+                # Every contact renewed: the slip that renews the last one draws no threshold, as in the tilt
+                # test. The stage's load at the end is f - pull U + f_bar (U kept in L_SHIFT, f in L_F).
+                loads[L_SHIFT] = shift
+                return _sample(pos, loads, f, p_mu, p_u, f)
+            continue
         if moving == N:
             # Every node is in motion at once (rule 3). Whether that motion is damped depends on the load
             # alone; the sliding rule (m slips, a displacement) only says when a motion above mu_d counts.
@@ -394,7 +459,7 @@ def _give_up(pos, loads, f, why):
 
 
 @kernel_jit(forceinline=True)
-def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moving, done, av_slips, shift):
+def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moving, done, av_slips, shift, renewed):
     """Keep where the test stands, to resume at ``stage`` once the buffers are longer."""
     pos[P_MU] = p_mu
     pos[P_U] = p_u
@@ -405,6 +470,7 @@ def _wait_for_draws(pos, loads, stage, p_mu, p_u, f, i, ep, slips, moving, done,
     pos[S_MOVING] = moving
     pos[S_DONE] = done
     pos[S_AV] = av_slips
+    pos[S_RENEWED] = renewed
     loads[L_F] = f
     loads[L_SHIFT] = shift
     return TILT_NEED_DRAWS
@@ -416,7 +482,7 @@ def tilt_test_network(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, ti
     """The network tilt test with straight-line slips (1D networks, and 2D with ``solver.slip = "straight"``):
     :func:`_tilt_test`, whose docstring gives the parameters."""
     return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      count, loads, slip_straight)
+                      count, loads, slip_straight, 0.0)
 
 
 @kernel_jit()
@@ -424,4 +490,20 @@ def tilt_test_network_exact(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_
                             epoch, count, loads):
     """The network tilt test with the exactly integrated 2D slip (``solver.slip = "exact"``)."""
     return _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch,
-                      count, loads, slip_exact)
+                      count, loads, slip_exact, 0.0)
+
+
+@kernel_jit()
+def shs_test_network(G, mu, f_ext, f_bar, net, settings, shs_mu, pos, heaps, epoch, count, loads, pull):
+    """The slide-hold-slide pull with straight-line slips: :func:`_tilt_test` with ``pull`` = gamma <k> > 0 on
+    ``net``, whose diagonal blocks hold the pull springs (``solver.scene.shs_operators``); thresholds redrawn
+    from ``shs_mu``. Returns f >= 0 at the end of the pull (its sample is ``loads[L_PEAK]``), or a code."""
+    return _tilt_test(G, mu, f_ext, f_bar, net, settings, False, shs_mu, shs_mu[:0], pos, 0, heaps, epoch, count,
+                      loads, slip_straight, pull)
+
+
+@kernel_jit()
+def shs_test_network_exact(G, mu, f_ext, f_bar, net, settings, shs_mu, pos, heaps, epoch, count, loads, pull):
+    """The slide-hold-slide pull with the exactly integrated 2D slip (``solver.slip = "exact"``)."""
+    return _tilt_test(G, mu, f_ext, f_bar, net, settings, False, shs_mu, shs_mu[:0], pos, 0, heaps, epoch, count,
+                      loads, slip_exact, pull)

@@ -53,9 +53,10 @@ STATE_BYTES = 46.0
 #: Bytes per thermal step of a running realization: theta(t_q), drawn for the whole run at once (8 bytes
 #: a step; the same command).
 THETA_BYTES = 9.0
-#: Bytes per value of a draw buffer (``solver.batch`` values each: the thresholds', and with tilt tests the tilt
-#: thresholds' and uniforms'), measured by the peak resident memory of one realization of a chain of 8 with
-#: solver.batch = 2^22 and 2^25: 8.0 bytes per value and buffer (24.0 with the tilt tests' two more).
+#: Bytes per value of a draw buffer (``solver.batch`` values each: the thresholds', with tilt tests the tilt
+#: thresholds' and uniforms', with ``mu_shs`` the pull's thresholds'), measured by the peak resident memory
+#: of one realization of a chain of 8 with solver.batch = 2^22 and 2^25: 8.0 bytes per value and buffer
+#: (24.0 with the tilt tests' two more).
 DRAW_BYTES = 8.0
 #: Bytes per realization and recorded time of the records held (n, mu_max, x_G, the tilt sums, the network's
 #: series, and the dataset assembled from them), the same command (record = "all", 2e5 and 2e6 steps).
@@ -154,7 +155,9 @@ def memory_estimate(cfg: Config, workers: int = 1, *, streamed: bool = False) ->
     running = min(int(workers), R)
     times = recorded_times(cfg)
     held = min(R, STREAMED + running) if streamed else R
-    buffers = 3 if "mu_eff" in cfg.observables else 1
+    tilt = 2 if "mu_eff" in cfg.observables else 0
+    pull = 1 if "mu_shs" in cfg.observables else 0
+    buffers = 1 + tilt + pull
     batch = cfg.solver.batch
     records_hint = "the records of each realization at each recorded time ('record', 'steps', 'realizations'" + (
         ")" if streamed else "; an output folder, --out, writes them 1024 realizations at a time)")
@@ -169,7 +172,8 @@ def memory_estimate(cfg: Config, workers: int = 1, *, streamed: bool = False) ->
             "running": f"the {running} realization(s) running at once, each drawing theta for all of its "
                        f"{cfg.steps:,} steps, {THETA_BYTES:.0f} bytes a step, holding {STATE_BYTES:.0f} bytes "
                        f"a slider and {batch:,} draws of mu_s in its buffer"
-                       + (" and two more of the tilt tests" if buffers > 1 else "")
+                       + (" and two more of the tilt tests" if tilt else "")
+                       + (" and one more of the slide-hold-slide pull" if pull else "")
                        + " ('steps', 'solver.batch'; fewer workers)",
             "records": f"{held:,} realizations x {times:,} recorded times, about {RECORD_BYTES:.0f} bytes each: "
                        + records_hint,

@@ -2,7 +2,7 @@
 
 Data flow for one realization (see ARCHITECTURE.md)::
 
-    SeedSequence child r --spawn(3)--> [driver, thresholds, tilt]; tilt --spawn(1)--> [tilt_uniforms]
+    SeedSequence child r --spawn(4)--> [driver, thresholds, tilt, shs]; tilt --spawn(1)--> [tilt_uniforms]
     driver.thetas(rng_driver, steps)      -> theta(t_q), q = 0..steps
     TruncatedStream(dist, rng_thresholds) -> initial mu_s, then one per slip, handed out in batches
     kernel (pair, csr or vec)             -> records at the recorded times
@@ -40,6 +40,7 @@ _REBUILT = {
     "series": "the kernels' view of out: the same arrays, restored in place",
     "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
     "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
+    "_shs_work": "scratch arrays of the slide-hold-slide pull, reset by every pull",
 }
 
 #: A stop request, polled where a kernel returns to refill a buffer: True asks the realization to stop there.
@@ -55,7 +56,7 @@ class Realization:
 
     Every value drawn is a function of ``seed_seq`` alone, never of
     ``solver.batch`` (which only sets how many values wait in the kernels'
-    buffers) nor of where the kernels stop. The four streams of
+    buffers) nor of where the kernels stop. The five streams of
     :func:`realization_streams` are read in this order:
 
     1. ``driver``: ``driver.thetas(rng, steps)``, once.
@@ -72,6 +73,9 @@ class Realization:
     4. ``tilt_uniforms``: ``rng.random()``, one value per creep branch of a
        tilt test (the uniform force of the appendix), in the order the tests
        read them.
+    5. ``shs``: a third ``TruncatedStream`` (``draws["shs"]``): the
+       thresholds the slide-hold-slide pulls redraw, one per slip but the
+       last of each pull, in the order the pulls read them.
 
     The tilt test reads thresholds and uniforms in proportions that depend
     on the state, so each kind has its own stream; buffers of either may be
@@ -106,9 +110,13 @@ class Realization:
             self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
         if scene.counts_capped:
             self.out["tilt_capped"] = np.zeros(T, np.int64)
+        if scene.shs_stiffness is not None:
+            # NaN where no pull was made: the recorded times after the network slid away.
+            self.out.update(mu_shs=np.full(T, np.nan), shs_travel=np.full(T, np.nan))
         self.out.update(_more_tilt_records(scene, T))
-        self._tilted = 0  # recorded times whose network tilt test is done
+        self._tilted = 0  # recorded times whose network tilt test (and slide-hold-slide pull) is done
         self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._shs_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
         self.state["theta"] = self.thetas[0]
         self.state["u"] = self.thetas[0]  # the spring at rest at theta(0): u = theta(0)
@@ -123,17 +131,18 @@ class Realization:
 
     @property
     def rngs(self) -> dict[str, np.random.Generator]:
-        """The realization's Generators by name (``driver``, ``thresholds``, ``tilt``, ``tilt_uniforms``)."""
+        """The realization's Generators by name (``driver``, ``thresholds``, ``tilt``, ``tilt_uniforms``,
+        ``shs``)."""
         return self.streams.rngs
 
     @property
     def draws(self) -> dict[str, TruncatedStream]:
-        """The truncated threshold streams by name (``thresholds``, ``tilt``)."""
+        """The truncated threshold streams by name (``thresholds``, ``tilt``, ``shs``)."""
         return self.streams.truncated
 
     @property
     def buffers(self) -> kernels.Draws:
-        """The draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``)."""
+        """The draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``, ``shs_mu``)."""
         return self.streams.buffers
 
     def recompute_forces(self) -> float:
@@ -188,7 +197,8 @@ class Realization:
         """Run the thermal steps up to ``to_step`` (default: the last one).
 
         With ``mu_eff_at = "records"`` the network tilt test is made on the
-        state at every recorded time passed on the way.
+        state at every recorded time passed on the way, and with the
+        observable ``mu_shs`` the slide-hold-slide pull (:meth:`shs_test`).
 
         Parameters
         ----------
@@ -208,13 +218,16 @@ class Realization:
         to_step = scene.steps if to_step is None else int(to_step)
         if not self.step <= to_step <= scene.steps:
             raise ValueError(f"to_step must lie in [{self.step}, {scene.steps}]; got {to_step}")
-        if scene.tilt_at == "records":
+        if scene.tilt_at == "records" or scene.shs_stiffness is not None:
             while self._tilted < scene.out_steps.size and scene.out_steps[self._tilted] <= to_step:
                 if not self._run_kernel(int(scene.out_steps[self._tilted]), stop):
                     return self  # stopped before the recorded time: no tilt test of a state in between
                 if self.slid_away:
                     return self  # no tilt test of a sliding network: mu_eff_count stays 0 from here on
-                self._tilt_record(self._tilted)
+                if scene.tilt_at == "records":
+                    self._tilt_record(self._tilted)
+                if scene.shs_stiffness is not None:
+                    self._shs_record(self._tilted)
                 self._tilted += 1
         self._run_kernel(to_step, stop)
         return self
@@ -249,13 +262,7 @@ class Realization:
         scene = self.scene
         o = scene.tilt_operators()
         N = scene.network.n_nodes
-        if self._tilt_work is None:
-            self._tilt_work = (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N, np.int64),
-                               np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS))
-        heaps, epoch, count, pos, loads = self._tilt_work
-        F = self.forces().reshape(N, -1)
-        G = np.zeros((N, 2))
-        G[:, : F.shape[1]] = F
+        (heaps, epoch, count, pos, loads), G = self._test_work("_tilt_work")
         mu = self.mu.copy() if mu is None else mu
         st = self.state
         pos[:] = 0
@@ -276,6 +283,79 @@ class Realization:
             # The test stands where it ran out: longer buffers, and it goes on from there.
             pos[tilt_net.P_MU], pos[tilt_net.P_U] = self.streams.extend_tilt(
                 st, (int(pos[tilt_net.P_MU]), int(pos[tilt_net.P_U])))
+
+    def _test_work(self, name: str) -> tuple[tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+                                             np.ndarray]:
+        """What a test on a copy of the state starts from: its scratch arrays (the attribute ``name``, made on
+        first use: heaps, epoch, count, pos, loads) and the forces G, shape (N, 2), 1D padded with zeros."""
+        from slidernet.kernels import tilt_net
+
+        N = self.scene.network.n_nodes
+        if getattr(self, name) is None:
+            setattr(self, name, (kernels.Heaps.empty(2, N), np.zeros(N, np.int64), np.zeros(N, np.int64),
+                                 np.zeros(tilt_net.N_POS, np.int64), np.zeros(tilt_net.N_LOADS)))
+        F = self.forces().reshape(N, -1)
+        G = np.zeros((N, 2))
+        G[:, : F.shape[1]] = F
+        return getattr(self, name), G
+
+    def shs_test(self, mu: np.ndarray | None = None, *, advance: bool = True) -> tuple[float, float]:
+        """One slide-hold-slide pull on a copy of the current state: mu_shs, and the stage's travel at the peak.
+
+        A stage moving quasi-statically along +x pulls every node i through a
+        spring of stiffness gamma N_i <k> (``[shs] stiffness`` = gamma, <k> the
+        mean spring stiffness) until every node has slipped at least once; the
+        sample is the peak of the stage force per unit normal load, plus the
+        mean f_ext along x (docs/model.md, "Slide-hold-slide";
+        :mod:`slidernet.kernels.tilt_net` for the rule). The state is left as it
+        was; the draws come from the realization's ``shs`` stream.
+
+        Parameters
+        ----------
+        mu : ndarray of float64, shape (N,), optional
+            The thresholds the pull starts from, which it overwrites (default:
+            a copy of the realization's, the contacts as the hold left them;
+            :meth:`tested_thresholds`).
+        advance : bool
+            True: the ``shs`` stream goes on after the draws this pull read.
+            False: it stays where it was, so that the next pull reads the same
+            draws (the injected twin of ``[tilt] inject``).
+
+        Returns
+        -------
+        mu_shs : float
+            The peak load per unit normal load.
+        travel : float
+            The stage's travel X from the start of the pull to that peak, in l0.
+        """
+        from slidernet.kernels import tilt_net
+
+        scene = self.scene
+        o = scene.shs_operators()
+        (heaps, epoch, count, pos, loads), G = self._test_work("_shs_work")
+        mu = self.mu.copy() if mu is None else mu
+        st = self.state
+        pos[:] = 0
+        pos[tilt_net.P_MU] = st["shs_mu_pos"][0]
+        settings = scene.settings()
+        while True:
+            end = o.test(G, mu, o.f_ext, o.f_bar, o.net, settings, self.buffers.shs_mu, pos, heaps, epoch, count,
+                         loads, o.pull)
+            status = kernels.tilt_status(end)
+            if status == kernels.DONE:
+                if advance:
+                    st["shs_mu_pos"] = pos[tilt_net.P_MU]
+                return float(loads[tilt_net.L_PEAK]), float(loads[tilt_net.L_TRAVEL] * scene.network.Ntilde)
+            if status != kernels.NEED_TILT:
+                slips = int(pos[tilt_net.N_SLIPS])
+                why = (f"it reached solver.max_avalanche = {scene.max_avalanche} slips in all. A genuinely long "
+                       "pull needs a larger solver.max_avalanche." if pos[tilt_net.STOP] == tilt_net.STOP_SLIPS
+                       else "a slip of the exactly integrated 2D motion (solver.slip = 'exact') did not come to "
+                            "rest within its step budget.")
+                raise TiltTestError(f"The slide-hold-slide pull did not renew every contact at step {self.step}: "
+                                    f"after {slips} slips, " + why)
+            # The pull stands where it ran out: a longer buffer, and it goes on from there.
+            pos[tilt_net.P_MU] = self.streams.extend_shs(st, int(pos[tilt_net.P_MU]))
 
     def _tilt_stop_reason(self, pos: np.ndarray, load: float, cap: int) -> str:
         """The message of a network tilt test that gave up (``pos[STOP]`` of the kernel says why)."""
@@ -361,6 +441,16 @@ class Realization:
         if self.scene.tilt_loads:
             out["tilt_first_slip" + suffix][k] = _mean_of_events([first for _, _, first, _ in tests])
             out["tilt_all_moving" + suffix][k] = _mean_of_events([moving for _, _, _, moving in tests])
+
+    def _shs_record(self, k: int) -> None:
+        """The slide-hold-slide pull at recorded time ``k``, after its injected twin under ``[tilt] inject``."""
+        if self.scene.inject is not None:
+            # The twin first, leaving the shs stream where it was, as the tilt test's twin does the tilt stream's.
+            try:
+                self.out["mu_shs_injected"][k], _ = self.shs_test(self.tested_thresholds(k, True), advance=False)
+            except TiltTestError as exc:
+                raise TiltTestError(f"The injected twin ([tilt] inject) of a pull: {exc}") from None
+        self.out["mu_shs"][k], self.out["shs_travel"][k] = self.shs_test(self.tested_thresholds(k, False))
 
     def _run_kernel(self, to_step: int, stop: StopCheck | None) -> bool:
         """Run the kernel to ``to_step``; False if ``stop`` asked it to stop first (see :meth:`advance`)."""
@@ -504,7 +594,9 @@ class Realization:
             record bin, shape (T,) (under a stricter sliding rule, ``tilt_capped``:
             the tests that met the avalanche cap first, which these leave out;
             with ``[tilt] repeats`` > 1, ``mu_eff_spread``; with ``[tilt] inject``,
-            the same of the injected twins, named ``*_injected``),
+            the same of the injected twins, named ``*_injected``), with the
+            observable ``mu_shs`` its pull's peak and the stage's travel there (l0),
+            ``mu_shs`` and ``shs_travel`` (NaN after the network slid away),
             and the scalar ``n_events``; where the
             scene can slide away (``scene.records_slide``), the scalar
             ``slid_away_at`` (tau_th; NaN if it did not); the backend's
@@ -534,11 +626,14 @@ class Realization:
 
 def _more_tilt_records(scene: Scene, T: int) -> dict[str, np.ndarray]:
     """The records of ``[tilt] repeats`` (``mu_eff_spread``) and of ``[tilt] inject`` (the injected twins' sums,
-    and their loads and cap counts where the plain tests have them), shape (T,) each."""
+    and their loads and cap counts where the plain tests have them; ``mu_shs_injected`` where the pull runs),
+    shape (T,) each."""
     out: dict[str, np.ndarray] = {}
     if scene.tilt_repeats > 1:
         out["mu_eff_spread"] = np.full(T, np.nan)
-    if scene.inject is not None:
+    if scene.inject is not None and scene.shs_stiffness is not None:
+        out["mu_shs_injected"] = np.full(T, np.nan)
+    if scene.inject is not None and scene.tilt_at == "records":
         out.update(f_sum_injected=np.zeros(T), f_sq_injected=np.zeros(T), f_count_injected=np.zeros(T, np.int64))
         if scene.tilt_loads:
             out.update(tilt_first_slip_injected=np.full(T, np.nan), tilt_all_moving_injected=np.full(T, np.nan))

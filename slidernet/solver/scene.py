@@ -169,6 +169,16 @@ class TiltOperators(NamedTuple):
     test: Callable[..., float]  # the compiled test of the scene's slip rule (tilt_test_network or its _exact)
 
 
+class ShsOperators(NamedTuple):
+    """What the slide-hold-slide pull runs on (:func:`slidernet.kernels.tilt_net.shs_test_network`)."""
+
+    net: Plane  # the tilt test's operators with each node's pull spring, gamma <k> N_i, in its K_ii along x
+    f_ext: np.ndarray  # (N, 2) external forces, in N
+    f_bar: float  # sum_i f_ext,i,x / sum_i N_i
+    pull: float  # gamma <k>, in k0 per unit normal load: the stage's load per unit normal load is pull (X - U)
+    test: Callable[..., float]  # the compiled pull of the scene's slip rule (shs_test_network or its _exact)
+
+
 @dataclass
 class Scene:
     """Everything a realization needs, derived once from a :class:`Config`.
@@ -216,10 +226,12 @@ class Scene:
     slip_factor: float = 2.0  # 1 + friction.overshoot: a slip's length over (|F_i| - mu_d N_i) / K_ii
     tilt_min_slips: int = 1  # the network tilt test's sliding rule (the [tilt] table)
     tilt_min_shift: float = 0.0  # ... and the centre of mass's displacement it needs, in Ntilde l0
+    shs_stiffness: float | None = None  # [shs] stiffness gamma with the observable mu_shs; None: no pull
     tilt_repeats: int = 1  # network tilt tests per recorded time ([tilt] repeats)
     inject: InjectConfig | None = None  # the aging injected into the tested copy ([tilt] inject); None: none
     operators: Chain | Plane | None = None
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
+    _shs_operators: ShsOperators | None = field(default=None, repr=False)
     _K: Any = field(default=None, repr=False)
 
     @property
@@ -254,6 +266,14 @@ class Scene:
         if self._tilt_operators is None:
             self._tilt_operators = _tilt_operators(self.network, self.operators, self.slip_mode)
         return self._tilt_operators
+
+    def shs_operators(self) -> ShsOperators:
+        """The operators of the slide-hold-slide pull (built on first use): the tilt test's, with the pull
+        springs."""
+        if self._shs_operators is None:
+            self._shs_operators = _shs_operators(self.network, self.tilt_operators(), float(self.shs_stiffness),
+                                                 self.slip_mode)
+        return self._shs_operators
 
     def settings(self) -> Settings:
         """The run's constants, as the kernels take them."""
@@ -294,7 +314,7 @@ class Scene:
             min_shift = tilt.min_displacement * reference_slip(
                 float(cfg.distribution().mean_max(1)), cfg.friction.mu_d, net.normal_load, net.k, 1.0,
                 cfg.friction.slip_factor())
-        return cls(
+        scene = cls(
             network=net,
             distribution=cfg.distribution(),
             driver=cfg.driver_plugin(),
@@ -325,9 +345,13 @@ class Scene:
             tilt_min_shift=min_shift,
             tilt_repeats=tilt.repeats if tilt_at == "records" else 1,
             # Where a test it raises runs (Config.injected_tests, the one rule).
-            inject=tilt.inject if tilt_at == "records" and cfg.injected_tests() else None,
+            inject=tilt.inject if cfg.injected_tests() else None,
+            shs_stiffness=cfg.shs_settings().stiffness if "mu_shs" in cfg.observables else None,
             operators=operators,
         )
+        if scene.shs_stiffness is not None:
+            scene.shs_operators()  # built now: pull springs that float64 cannot hold are refused before any work
+        return scene
 
 
 def creep_spec(cfg: Config, net: Network) -> CreepSpec:
@@ -380,6 +404,39 @@ def _tilt_operators(net: Network, operators: Chain | Plane, slip_mode: int) -> T
     f_ext[:, :d] = net.f_ext
     test = tilt_net.tilt_test_network_exact if slip_mode == SLIP_EXACT else tilt_net.tilt_test_network
     return TiltOperators(net=plane, f_ext=f_ext, f_bar=mean_load(net), pair_rule=N == 2 and d == 1, test=test)
+
+
+def _shs_operators(net: Network, tilt: TiltOperators, stiffness: float, slip_mode: int) -> ShsOperators:
+    """The tilt test's operators with every node's pull spring gamma <k> N_i added to its K_ii along x.
+
+    A lattice keeps its table of distinct blocks: the diagonal blocks with their pull springs are added to
+    it, each distinct one once (a few with equal normal loads). Any other network has a block per entry and
+    gets its own copy.
+    """
+    plane = tilt.net
+    pull = stiffness * float(np.mean(net.k))
+    spring = pull * plane.normal_load
+    diagonal_xx = plane.K_table[:, 0, 0] + spring.max()
+    if not spring.min() >= np.finfo(np.float64).tiny or not np.isfinite(diagonal_xx).all():
+        # A zero pull would be the tilt test's (the kernel's pull = 0); a subnormal one, or one that overflows
+        # K_ii, leaves no digits to the slips or the stage's travel f / pull.
+        raise ConfigError(
+            f"The 'shs.stiffness' value {stiffness!r} gives pull springs gamma <k> N_i from "
+            f"{float(spring.min())!r} to {float(spring.max())!r} k0 (<k> = {float(np.mean(net.k))!r}), which "
+            f"float64 cannot hold beside the network's springs; use a stiffness nearer 1.")
+    table = plane.K_table.copy()
+    K_id = plane.K_id.copy()
+    if plane.block_per_entry:
+        table[plane.diag, 0, 0] += spring
+    else:
+        diagonal = table[K_id[plane.diag]]
+        diagonal[:, 0, 0] += spring
+        blocks, which = np.unique(diagonal, axis=0, return_inverse=True)
+        K_id[plane.diag] = table.shape[0] + which.reshape(-1)
+        table = np.concatenate([table, blocks])
+    test = tilt_net.shs_test_network_exact if slip_mode == SLIP_EXACT else tilt_net.shs_test_network
+    return ShsOperators(net=plane._replace(K_table=table, K_id=K_id), f_ext=tilt.f_ext, f_bar=tilt.f_bar,
+                        pull=pull, test=test)
 
 
 def tilt_avalanche_cap(n_nodes: int) -> int:

@@ -18,8 +18,9 @@ Keys of ``arrays``:
     float64 (N,): the thresholds mu_s of the nodes.
 ``buffers/<name>``, ``surplus/<name>``
     The random side (:class:`~slidernet.solver.streams.Streams`): the
-    draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``) and the
-    surplus of the ``thresholds`` and ``tilt`` threshold streams.
+    draws waiting for the kernels (``mu``, ``tilt_mu``, ``tilt_u``,
+    ``shs_mu``) and the surplus of the ``thresholds``, ``tilt`` and ``shs``
+    threshold streams.
 ``out/<name>``
     The records written so far.
 ``backend/<name>``
@@ -29,7 +30,7 @@ Keys of ``arrays``:
 
 Keys of ``header``: ``scene`` (:func:`scene_fingerprint`), ``thetas`` (a
 digest of theta(t_q)), ``rngs`` (each Generator's ``bit_generator.state``),
-``tilted`` (recorded times whose network tilt test is done), ``step`` and
+``tilted`` (recorded times whose network tilt test and slide-hold-slide pull are done), ``step`` and
 ``n`` (for information).
 """
 
@@ -112,6 +113,8 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         # Likewise [tilt] repeats and inject, only where set.
         **({} if scene.tilt_repeats == 1 else {"tilt_repeats": int(scene.tilt_repeats)}),
         **({} if scene.inject is None else {"inject": scene.inject.model_dump(mode="json")}),
+        # Only with the slide-hold-slide pull, likewise.
+        **({} if scene.shs_stiffness is None else {"shs_stiffness": float(scene.shs_stiffness)}),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": digest(*(getattr(ops, name) for name in _K_FIELDS if name in ops._fields)),

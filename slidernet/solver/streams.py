@@ -24,16 +24,19 @@ from slidernet.solver.snapshot import take
 def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random.Generator]:
     """The independent random streams of one realization, in their documented order.
 
-    ``seed_seq.spawn(3)`` gives, in order: the driver, the thresholds of the
-    horizontal evolution, and the virtual tilt test's thresholds. The tilt
-    test's uniforms, ``"tilt_uniforms"``, come from the first child of the
-    tilt child (spawn key ``seed_seq.spawn_key + (2, 0)``): the tilt test reads
-    thresholds and uniforms in proportions that depend on the state, so each
-    kind needs a stream of its own for its values to be a function of the
-    seed alone. The tilt test never touches the first two streams, so
-    requesting ``mu_eff`` leaves n, mu_max and x_G unchanged to the bit. The
-    same ``seed_seq`` always gives the same streams, even after it has been
-    spawned from.
+    ``seed_seq.spawn(4)`` gives, in order: the driver, the thresholds of the
+    horizontal evolution, the virtual tilt test's thresholds, and the
+    slide-hold-slide pull's thresholds (``"shs"``, spawn key
+    ``seed_seq.spawn_key + (3,)``, added last: spawning one more child leaves
+    the first three as they were). The tilt test's uniforms,
+    ``"tilt_uniforms"``, come from the first child of the tilt child (spawn
+    key ``seed_seq.spawn_key + (2, 0)``): the tilt test reads thresholds and
+    uniforms in proportions that depend on the state, so each kind needs a
+    stream of its own for its values to be a function of the seed alone.
+    Neither test touches the first two streams, nor the other's, so
+    requesting ``mu_eff`` or ``mu_shs`` leaves n, mu_max and x_G unchanged to
+    the bit. The same ``seed_seq`` always gives the same streams, even after
+    it has been spawned from.
 
     Examples
     --------
@@ -48,12 +51,13 @@ def realization_streams(seed_seq: np.random.SeedSequence) -> dict[str, np.random
     # of its seed alone, however often that seed is used (reruns, comparisons).
     pristine = np.random.SeedSequence(seed_seq.entropy, spawn_key=seed_seq.spawn_key,
                                       pool_size=seed_seq.pool_size)
-    children = pristine.spawn(3)
+    children = pristine.spawn(4)
     streams = {name: np.random.Generator(np.random.PCG64(child))
-               for name, child in zip(names, children, strict=True)}
+               for name, child in zip(names, children[:3], strict=True)}
     # Spawning from the tilt child leaves its own Generator (made above from its
     # entropy pool) as it always was: the tilt thresholds keep their stream.
     streams["tilt_uniforms"] = np.random.Generator(np.random.PCG64(children[2].spawn(1)[0]))
+    streams["shs"] = np.random.Generator(np.random.PCG64(children[3]))
     return streams
 
 
@@ -130,16 +134,17 @@ class Streams:
     piece of randomness a realization holds, and :meth:`snapshot` /
     :meth:`restore` carry all of it:
 
-    - ``rngs``: the four Generators of :func:`realization_streams`;
-    - ``truncated``: the two :class:`TruncatedStream` of accepted thresholds,
-      ``"thresholds"`` (the horizontal evolution) and ``"tilt"`` (the tilt
-      tests), each with its surplus;
+    - ``rngs``: the five Generators of :func:`realization_streams`;
+    - ``truncated``: the three :class:`TruncatedStream` of accepted thresholds,
+      ``"thresholds"`` (the horizontal evolution), ``"tilt"`` (the tilt
+      tests) and ``"shs"`` (the slide-hold-slide pulls), each with its surplus;
     - ``buffers``: the draws waiting for the kernels
-      (:class:`slidernet.kernels.Draws`: ``mu``, ``tilt_mu``, ``tilt_u``);
+      (:class:`slidernet.kernels.Draws`: ``mu``, ``tilt_mu``, ``tilt_u``,
+      ``shs_mu``);
     - the refill rule (:meth:`refill`).
 
     The read positions in the buffers (``mu_pos``, ``tilt_mu_pos``,
-    ``tilt_u_pos``) belong to the realization's state record, which the
+    ``tilt_u_pos``, ``shs_mu_pos``) belong to the realization's state record, which the
     kernels advance; :meth:`refill` reads them and sets them back to 0.
 
     Constructing it draws nothing; :meth:`start` draws theta(t_q), the
@@ -171,7 +176,7 @@ class Streams:
         # surplus is state, and where the kernels stop to refill, or how much
         # they ask for, never changes a value.
         self.truncated = {name: TruncatedStream(scene.distribution, self.rngs[name])
-                          for name in ("thresholds", "tilt")}
+                          for name in ("thresholds", "tilt", "shs")}
         self.buffers = Draws(np.empty(0), np.empty(0), np.empty(0))
 
     def start(self) -> tuple[np.ndarray, np.ndarray]:
@@ -179,7 +184,8 @@ class Streams:
 
         The order is the documented one: the driver's thetas, the N initial
         thresholds, a batch of thresholds, then (with tilt tests) a batch of
-        tilt thresholds and a batch of uniforms.
+        tilt thresholds and a batch of uniforms, and (with slide-hold-slide)
+        a batch of its thresholds.
         """
         scene = self.scene
         thetas, mu, _ = horizontal_draws(scene, self.rngs, self.truncated["thresholds"])
@@ -189,7 +195,8 @@ class Streams:
             tilt = (self.truncated["tilt"].take(batch), self.rngs["tilt_uniforms"].random(batch))
         else:
             tilt = (np.empty(0), np.empty(0))
-        self.buffers = Draws(mu_batch, *tilt)
+        shs = self.truncated["shs"].take(batch) if scene.shs_stiffness is not None else np.empty(0)
+        self.buffers = Draws(mu_batch, *tilt, shs)
         return thetas, mu
 
     def refill(self, status: int, state: np.ndarray) -> bool:
@@ -252,11 +259,29 @@ class Streams:
         pair's creep rule alone). Values read before the realization's
         position are dropped, both positions moving back with them.
         """
+        p_mu, p_u = self._extend(state, (("tilt_mu", self.truncated["tilt"].take, reading[0]),
+                                         ("tilt_u", self.rngs["tilt_uniforms"].random, reading[1])))
+        return p_mu, p_u
+
+    def extend_shs(self, state: np.ndarray, reading: int) -> int:
+        """Lengthen the slide-hold-slide buffer under a pull that ran out of draws; its new read position.
+
+        The rule of :meth:`extend_tilt`, for the one buffer the pull reads
+        (``shs_mu``, from the ``shs`` stream; the realization's position
+        ``shs_mu_pos``).
+        """
+        (p_mu,) = self._extend(state, (("shs_mu", self.truncated["shs"].take, reading),))
+        return p_mu
+
+    def _extend(self, state: np.ndarray, plan: tuple[tuple[str, Callable[[int], np.ndarray], int], ...]
+                ) -> list[int]:
+        """Each buffer of ``plan`` (name in :class:`Draws`, its stream, the test's reading position in it) with
+        fewer than ``batch`` values after its reading grown as :meth:`extend_tilt` says; the new positions."""
         batch, st, buf = self.scene.batch, state[0], self.buffers
         grown = {}
         new_reading = []
-        for name, stream, key, at in (("tilt_mu", self.truncated["tilt"].take, "tilt_mu_pos", reading[0]),
-                                      ("tilt_u", self.rngs["tilt_uniforms"].random, "tilt_u_pos", reading[1])):
+        for name, stream, at in plan:
+            key = f"{name}_pos"  # the realization's read position, a field of the state record
             values, start = getattr(buf, name), int(st[key])
             if values.size - at < batch:
                 kept = values[start:]
@@ -265,7 +290,7 @@ class Streams:
                 at -= start
             new_reading.append(int(at))
         self.buffers = buf._replace(**grown)
-        return new_reading[0], new_reading[1]
+        return new_reading
 
     def snapshot(self) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
         """The streams' state: JSON values (``rngs``: each Generator's ``bit_generator.state``) and arrays
