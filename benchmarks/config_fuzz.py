@@ -327,7 +327,8 @@ def _estimate(case: Case) -> float | None:
             "print(budget.warn_if_slow(cfg, scene, 1))\n")
     try:
         done = subprocess.run([sys.executable, "-c", code, str(case.folder / "case.toml")], capture_output=True,
-                              text=True, timeout=120, cwd=case.folder)
+                              # A scene of 5e7 sliders took over 120 s to build beside other jobs (case 318).
+                              text=True, timeout=600, cwd=case.folder)
         return float(done.stdout.strip().splitlines()[-1])
     except (subprocess.TimeoutExpired, ValueError, IndexError):
         return None
@@ -412,10 +413,15 @@ def run_case(case: Case, workers: int, timeout: float, stop_timeout: float) -> C
 
 
 def fuzz(cases: int, seed: int, jobs: int, timeout: float, stop_timeout: float, root: Path,
-         workers: int = 1) -> list[Case]:
-    """Make and run ``cases`` cases in ``root``, ``jobs`` at a time; print one line per case as it ends."""
+         workers: int = 1, only: set[int] | None = None) -> list[Case]:
+    """Make and run ``cases`` cases in ``root``, ``jobs`` at a time; print one line per case as it ends.
+
+    ``only``: run just the cases of these indices (every case is still made, so each is the case of the
+    whole run of that seed)."""
     rng = random.Random(seed)
     made = [make_case(i, rng, root) for i in range(cases)]
+    if only is not None:
+        made = [case for case in made if case.index in only]
     done: list[Case] = []
     with ThreadPoolExecutor(jobs) as pool:
         for case in pool.map(lambda c: run_case(c, workers, timeout, stop_timeout), made):
@@ -460,6 +466,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stop-timeout", type=float, default=30.0,
                         help="seconds one SIGTERM has to stop a case past its time (default 30)")
     parser.add_argument("--keep", type=Path, help="work in this folder and keep it (default: a temporary one)")
+    parser.add_argument("--only", type=int, nargs="+", metavar="INDEX",
+                        help="run only these cases of the seed's --cases (a failed case again, say)")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         root = args.keep or Path(tmp)
@@ -468,7 +476,8 @@ def main(argv: list[str] | None = None) -> int:
         warm(root, args.workers)
         print(f"{len(BASES)} base scenes ran ({time.monotonic() - t0:.0f} s); {args.cases} cases, "
               f"seed {args.seed}, {args.jobs} at a time, {args.case_timeout:g} s each", flush=True)
-        done = fuzz(args.cases, args.seed, args.jobs, args.case_timeout, args.stop_timeout, root, args.workers)
+        done = fuzz(args.cases, args.seed, args.jobs, args.case_timeout, args.stop_timeout, root, args.workers,
+                    None if args.only is None else set(args.only))
         print(summary(done))
         print(f"{time.monotonic() - t0:.0f} s in all")
         return 0 if all(c.ok for c in done) else 1
