@@ -25,8 +25,10 @@ two-level over network geometries where there are several
   a friction coefficient of the whole network, an average of its contacts'
   forces, sees at most the mean.
 * **Estimators**: ``mu_eff`` (the load at which the network slides as a
-  whole), ``tilt_first_slip`` (the load at the test's first slip) and
-  ``tilt_all_moving`` (the load once every node has slipped in it).
+  whole), ``tilt_first_slip`` (the load at the test's first slip),
+  ``tilt_all_moving`` (the load once every node has slipped in it) and
+  ``mu_shs`` (the peak force of the slide-hold-slide pull, stiffness 1,
+  on the same state with the same injection).
 * **Systems**: ratio sigma_mu / (mean - mu_d) = 0.3 at mu_d = 0.5,
   sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade;
   the pair, free chains of 4 and 16, irregular networks of 16 and 64 (16
@@ -82,13 +84,14 @@ OVERSHOOTS = (1.0, 0.5, 0.0)
 # Each estimator: its per-realization variable, without and with the injection.
 ESTIMATORS = {"mu_eff": ("mu_eff_realization", "mu_eff_injected_realization"),
               "tilt_first_slip": ("tilt_first_slip", "tilt_first_slip_injected"),
-              "tilt_all_moving": ("tilt_all_moving", "tilt_all_moving_injected")}
+              "tilt_all_moving": ("tilt_all_moving", "tilt_all_moving_injected"),
+              "mu_shs": ("mu_shs", "mu_shs_injected")}
 WINDOWS = {"10-1e3": 10.0, "1-1e3": 1.0}  # t_min of each window; t_max: the run's end
 
 
 def _systems(tag: str, inject: tuple[float, float], e: float) -> list[study.Group]:
     """The full preset's systems at one injection and one slip rule (ratio 0.3)."""
-    common = {"params": ("ratio0.3",), "overshoot": e, "inject": inject}
+    common = {"params": ("ratio0.3",), "overshoot": e, "inject": inject, "observables": ("mu_shs",)}
     return [study.Group(f"{tag}_pair", "pair", (2,), realizations=32, **common),
             study.Group(f"{tag}_chains", "chain", (4, 16), realizations=32, **common),
             study.Group(f"{tag}_irregular_small", "irregular", (16, 64), geometries=16, realizations=32, **common),
@@ -108,9 +111,10 @@ PRESETS = {
     "quick": study.Preset(
         realizations=4, steps=100, per_decade=5, mechanism=(),
         groups=tuple(g for q in SELECTS for g in (
-            study.Group(f"{_tag(q, 1.0)}_pair", "pair", (2,), ("ratio0.3",), inject=(INJECT_C, q)),
+            study.Group(f"{_tag(q, 1.0)}_pair", "pair", (2,), ("ratio0.3",), inject=(INJECT_C, q),
+                        observables=("mu_shs",)),
             study.Group(f"{_tag(q, 1.0)}_irregular", "irregular", (16,), ("ratio0.3",), 2,
-                        inject=(INJECT_C, q))))),
+                        inject=(INJECT_C, q), observables=("mu_shs",))))),
 }
 
 
@@ -165,9 +169,9 @@ def tables(data: dict[str, Any]) -> str:
         norm = "contact" if select == 1.0 else "mean"
         lines += [f"### Injection into {'every contact' if select == 1.0 else 'the 10 % oldest contacts'} "
                   f"(select = {select:g}), recovery of the {'shift' if select == 1.0 else 'mean shift'}", "",
-                  "| e | network | N | R (G) | μ_eff, 10–1e3 | μ_eff, 1–1e3 | first slip | all moving "
+                  "| e | network | N | R (G) | μ_eff, 10–1e3 | μ_eff, 1–1e3 | first slip | all moving | μ_shs "
                   "| dμ_eff/dlog10 t, plain (1e-4) |",
-                  "|---|---|---|---|---|---|---|---|---|"]
+                  "|---|---|---|---|---|---|---|---|---|---|"]
         for p in data["points"]:
             if p["select"] != select:
                 continue
@@ -176,6 +180,7 @@ def tables(data: dict[str, Any]) -> str:
                 f"| {p['overshoot']:g} | {study._label(p)} | {p['N']} | {p['realizations']} ({p['geometries']}) | "
                 f"{_pm(r[f'mu_eff|10-1e3|{norm}'])} | {_pm(r[f'mu_eff|1-1e3|{norm}'])} | "
                 f"{_pm(r[f'tilt_first_slip|10-1e3|{norm}'])} | {_pm(r[f'tilt_all_moving|10-1e3|{norm}'])} | "
+                f"{_pm(r[f'mu_shs|10-1e3|{norm}'])} | "
                 f"{1e4 * r[f'mu_eff|10-1e3|{norm}']['plain_slope_per_decade']:+.1f} |")
         lines.append("")
     return "\n".join(lines)
@@ -183,7 +188,7 @@ def tables(data: dict[str, Any]) -> str:
 
 def plot(data: dict[str, Any], path: Path) -> Path:
     """Recovery against N: one panel per estimator and injection, one line per slip rule and kind."""
-    fig = Figure(figsize=(12, 6.5), layout="constrained")
+    fig = Figure(figsize=(15, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(SELECTS), len(ESTIMATORS), sharex=True, squeeze=False)
     for row, select in enumerate(SELECTS):
