@@ -1,10 +1,14 @@
-"""The statistics of ``examples/aging_networks.py``: slopes in fit windows, relative rates, variance components,
-one fit of slope(N), equivalence to a declared margin, and one multiple-testing family.
+"""The statistics of the aging study: windows, relative rates, geometries, slope(N), margins, one family
+=====================================================================================================
 
-A helper module of the aging study (docs/guides/aging-networks.md), imported
-by the study's script; it runs nothing. Every slope is per decade of t; every
-error is from independent units (realizations, or the means of network
-geometries, :func:`slidernet.analysis.trend.grouped_mean_sem`).
+The statistics of ``examples/aging_networks.py``: slopes in fit windows,
+rates relative to the level above mu_d, variance components, one fit of
+slope(N), equivalence to a margin declared before the run, the minimum
+detectable effect, and one multiple-testing family. A helper module of
+the aging study (docs/guides/aging-networks.md), imported by the study's
+script; it runs nothing. Every slope is per decade of t; every error is
+from independent units (realizations, or the means of network geometries,
+:func:`slidernet.analysis.trend.grouped_mean_sem`).
 """
 
 from __future__ import annotations
@@ -28,17 +32,12 @@ from slidernet.analysis.trend import grouped_mean_sem, log_trend, relative_rate
 
 LN10 = math.log(10.0)
 
-# The margin of "no aging", declared before the restated study's run. At ratio 0.3 the pair's mu_eff rises by
-# (94 +- 13)e-4 per decade (records' estimator, 32 realizations to 1e3 tau_th). A network whose slope is within
-# a tenth of that, +-9.4e-4 per decade, ages at most a tenth as fast as the pair, in the estimator's own units:
-# the pair's rate is known to 14 %, so a tenth of it is 7 of the pair's standard errors away from it, and the
-# networks' errors (0.2e-4 to 7.9e-4 per decade) can resolve it. The margin bounds the estimator's slope, not
-# the thresholds' aging: divided by an estimator's recovery (examples/aging_recovery.py) it bounds the latter.
-MARGIN_PER_DECADE = 0.1 * 94e-4
 # The window in slips per node: aging by selection keeps the strongest of the thresholds each node has drawn,
 # a function of its number of renewals, not of t. From 100 slips per node on, every system is compared at the
-# same renewal history: the pair and the chains reach it at 70 to 130 tau_th, the irregular networks by about
-# 5 tau_th (slips per node at 1e3 tau_th: 800 to 2100 along chains, 13000 to 25000 in irregular networks).
+# same renewal history. The slips per node grow about linearly in t; from their values at 1e3 tau_th (the
+# guide's table: 600 to 2100 for the pair and chains, 4000 to 11000 for lattices, 7000 to 25000 for irregular
+# networks) the pair and the chains reach 100 at about 50 to 170 tau_th, lattices at 10 to 25, irregular
+# networks at 4 to 14.
 SLIPS_MIN = 100.0
 # The fit windows: t_min (tau_th) and the least slips per node; each to the run's end. A window needs a decade.
 WINDOWS = {"t>=1": (1.0, None), "t>=10": (10.0, None), "t>=100": (100.0, None), "t>=1e3": (1e3, None),
@@ -59,28 +58,32 @@ def estimate(values: np.ndarray, geometry: np.ndarray) -> dict[str, Any]:
     return {"mean": mean, "sem": sem, "dof": dof, "p": p}
 
 
-def slope_estimate(per_decade: np.ndarray, geometry: np.ndarray) -> dict[str, Any]:
-    """:func:`estimate` of per-realization slopes, with the minimum detectable effect (two-sided 5 %, power 0.8)
-    and the two one-sided tests against +-:data:`MARGIN_PER_DECADE`."""
-    out = estimate(per_decade, geometry)
+def _absence(out: dict[str, Any], margin: float) -> dict[str, Any]:
+    """An estimate with its minimum detectable effect (two-sided 5 %, power 0.8) and the two one-sided tests
+    against +-``margin`` (where it has an error)."""
     if out["sem"] > 0 and out["dof"] > 0 and math.isfinite(out["mean"]):
         out["mde"] = minimum_detectable_effect(out["sem"], out["dof"])
-        eq = equivalence_test(out["mean"], out["sem"], out["dof"], MARGIN_PER_DECADE)
-        out["equivalence"] = {"margin": MARGIN_PER_DECADE, "p": eq.p, "equivalent": eq.equivalent,
-                              "ci90": list(eq.ci)}
+        eq = equivalence_test(out["mean"], out["sem"], out["dof"], margin)
+        out["equivalence"] = {"margin": margin, "p": eq.p, "equivalent": eq.equivalent, "ci90": list(eq.ci)}
     else:
         out["mde"] = math.nan
     return out
 
 
-def trend(values: xr.DataArray, geometry: np.ndarray, against: xr.DataArray | None = None) -> dict[str, Any]:
+def slope_estimate(per_decade: np.ndarray, geometry: np.ndarray, margin: float) -> dict[str, Any]:
+    """:func:`estimate` of per-realization slopes (per decade), with its MDE and equivalence to +-``margin``."""
+    return _absence(estimate(per_decade, geometry), margin)
+
+
+def trend(values: xr.DataArray, geometry: np.ndarray, margin: float,
+          against: xr.DataArray | None = None) -> dict[str, Any]:
     """A per-realization variable: its value at t = 0, 1 and t_end, and its slope per decade of t (or of the
     abscissa ``against``) over t >= 1, each with its error from independent realizations (and geometries)."""
     tr = log_trend(values, t_min=1, against=against)
     v = values.transpose("realization", "t")
     return {"t0": estimate(v.sel(t=0).values, geometry), "t1": estimate(v.sel(t=1).values, geometry),
             "end": estimate(v.isel(t=-1).values, geometry), "t_end": float(v["t"].values[-1]),
-            "slope_per_decade": slope_estimate(LN10 * tr["slope"].values, geometry),
+            "slope_per_decade": slope_estimate(LN10 * tr["slope"].values, geometry, margin),
             "realizations": int(tr["realizations"]), "not_finite": int((~np.isfinite(v.values)).sum())}
 
 
@@ -100,7 +103,8 @@ def _components(per_decade: np.ndarray, geometry: np.ndarray) -> dict[str, Any]:
                   "per_group": vc.per_group, "ms_between": vc.ms_between, "ms_within": vc.ms_within}
 
 
-def windows(ds: xr.Dataset, geometry: np.ndarray, N: int, mu_d: float, several_geometries: bool) -> dict[str, Any]:
+def windows(ds: xr.Dataset, geometry: np.ndarray, N: int, mu_d: float, several_geometries: bool,
+            margin: float) -> dict[str, Any]:
     """Every estimator's slope in every fit window of :data:`WINDOWS` that the run covers by a decade.
 
     For ``mu_eff`` also its rate relative to its own level above mu_d
@@ -127,7 +131,7 @@ def windows(ds: xr.Dataset, geometry: np.ndarray, N: int, mu_d: float, several_g
             w: dict[str, Any] = {"t_min": t_min, "slips_min": s_min, "t_start": tr.attrs["t_start"],
                                  "t_end": tr.attrs["t_end"], "realizations": int(tr["realizations"]),
                                  "records": float(records.sum(axis=1).mean()),
-                                 "slope_per_decade": slope_estimate(per_decade, geometry)}
+                                 "slope_per_decade": slope_estimate(per_decade, geometry, margin)}
             if name == "mu_eff" and int(tr["realizations"]) >= 2:
                 rel = relative_rate(tr["slope"].values, tr["level"].values, geometry, floor=mu_d)
                 w["relative"] = {"rate_per_decade": LN10 * rel.rate, "sem": LN10 * rel.sem, "dof": rel.dof,
@@ -142,7 +146,7 @@ def windows(ds: xr.Dataset, geometry: np.ndarray, N: int, mu_d: float, several_g
     return out
 
 
-def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def fits(points: list[dict[str, Any]], margin: float) -> list[dict[str, Any]]:
     """One random-effects fit of mu_eff's slope against N^-1/2 per parameter set, rule and condition, per window.
 
     Against N^-1/2, not ln N: at e = 1 mu_eff - mu_d falls as N^-1/2, so a
@@ -173,12 +177,7 @@ def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
             for i, name in enumerate(("infinite_N", "per_N^-1/2")):
                 c = {"mean": float(fit.coef[i]), "sem": float(fit.coef_sem[i]), "dof": fit.dof,
                      "p": float(fit.coef_p[i])}
-                if name == "infinite_N":
-                    c["mde"] = minimum_detectable_effect(c["sem"], c["dof"])
-                    eq = equivalence_test(c["mean"], c["sem"], c["dof"], MARGIN_PER_DECADE)
-                    c["equivalence"] = {"margin": MARGIN_PER_DECADE, "p": eq.p, "equivalent": eq.equivalent,
-                                        "ci90": list(eq.ci)}
-                coef[name] = c
+                coef[name] = _absence(c, margin) if name == "infinite_N" else c
             out.append({"params": params, "rule": rule, "condition": condition, "window": label,
                         "x": "N^-1/2", "sizes": [int(v) for v in n], "kinds": sorted({p["kind"] for p in pts}),
                         "coef": coef, "tau2": fit.tau2, "q": fit.q, "q_dof": fit.q_dof, "q_p": fit.q_p,
@@ -258,7 +257,7 @@ def tables(data: dict[str, Any], label: Any) -> list[str]:
     """The restated study's tables (Markdown lines), from the study's JSON; ``label`` names a point."""
     pts = data["points"]
     heads = list(WINDOWS)
-    m = f"{MARGIN_PER_DECADE * 1e4:.1f}e-4"
+    m = f"{data['windows']['margin_per_decade'] * 1e4:.1f}e-4"
     lines = ["### Slopes in fit windows (1e-4 per decade)", "",
              "Each cell: slope ± standard error (dof), minimum detectable effect (two-sided 5 %, power 0.8), "
              f"≡ where the two one-sided tests put it within ±{m} per decade (the margin declared in the script), "

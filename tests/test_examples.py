@@ -231,7 +231,7 @@ def check_aging_statistics(study, data):
                 if label.startswith("t") and not (p["mu_eff_at"] != "records" or name == "tilt_all_moving"):
                     assert math.isfinite(s["mean"]) and s["sem"] > 0 and s["mde"] > 2 * s["sem"]
                     eq = s["equivalence"]
-                    assert eq["margin"] == stats.MARGIN_PER_DECADE
+                    assert eq["margin"] == study.MARGIN_PER_DECADE
                     assert eq["equivalent"] == (-eq["margin"] < eq["ci90"][0] and eq["ci90"][1] < eq["margin"])
         for w in p["windows"]["mu_eff"].values():
             r = w.get("relative")
