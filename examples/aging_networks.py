@@ -256,21 +256,22 @@ def _scan(sizes: tuple[int, ...], params: tuple[str, ...], geometries: int, repe
 
 def _restated() -> tuple[Group, ...]:
     """The groups of the restated study (issue 44, item 4), beside the study's own; realizations sized so that
-    the full preset keeps within an hour on two cores (estimates in the comments: CPU time at 2 workers)."""
+    the full preset keeps within an hour on two cores (estimates in the comments: wall time at 2 workers)."""
     long = {"params": ("ratio0.3", "ratio0.2"), "steps": 10_000}
     e_scan = [(e, {"overshoot": e}) for e in (0.0, 0.5)]
     return (
-        # To 1e4 tau_th (10x a realization's cost), N <= 256, where the pair ages (about 7 min).
+        # To 1e4 tau_th (8-10x a realization's cost, measured), N <= 256, where the pair ages (about 6 min).
         Group("pair_1e4", "pair", (2,), **long),
         Group("pair_appendix_1e4", "pair", (2,), mu_eff_at="rearrangements", **long),
         Group("chains_1e4", "chain", (4, 16), **long),
         Group("irregular_1e4", "irregular", (16, 64, 256), geometries=8, realizations=16, **long),
-        # sigma_theta / Ntilde = 10 (about 10x the cost), at ratio 0.3 (about 5 min).
+        # sigma_theta / Ntilde = 10 (8-20x the cost at 64 sliders, 30x at 256), at ratio 0.3 (about 4 min).
         Group("pair_amp10", "pair", (2,), ("ratio0.3",), amplitude=10.0),
         Group("chains_amp10", "chain", (4, 16), ("ratio0.3",), amplitude=10.0),
         Group("irregular_amp10", "irregular", (16, 64), ("ratio0.3",), 8, realizations=16, amplitude=10.0),
         Group("irregular_256_amp10", "irregular", (256,), ("ratio0.3",), 4, realizations=8, amplitude=10.0),
-        # The e < 1 scan to 1024 sliders, along chains and lattices, and at mu_d = 0.4 (about 7 min).
+        # The e < 1 scan to 1024 sliders, along chains and lattices, and at mu_d = 0.4 (about 7 min; at 1024
+        # sliders e = 0 costs 2.4x as much as e = 1).
         *(g for e, rule in e_scan for g in (
             Group(f"irregular_1024_e{e:g}", "irregular", (1024,), ("base", "ratio0.3"), 4, realizations=8,
                   **rule),
@@ -292,7 +293,8 @@ PRESETS = {
             Group("chains", "chain", (4, 16)),
             Group("irregular", "irregular", (16, 64, 256, 1024), geometries=8),
             Group("lattices", "triangular", (4, 8, 16, 32)),
-            # K = 4 tests per record at e = 1 (about +35 % of a run's cost at 256 sliders, e = 1, measured).
+            # K = 4 tests per record at e = 1 (+35 % of a run's cost at 256 sliders, +51 % under
+            # min_displacement = 10, measured).
             *_scan((16, 64, 256), ("base", "ratio0.3"), 8, repeats=4),
             *_restated(),
         ),
@@ -300,7 +302,7 @@ PRESETS = {
     ),
     # Beyond the full preset's budget: 4096 sliders, 8 geometries x 2 realizations to 300 tau_th, at the base
     # and at the control where the pair ages, with the pair at the same times, at e = 1, 0.5 and 0 (about
-    # 100 min of CPU: 25 at e = 1, e < 1 costing 1.4-1.7x as much).
+    # 2 h of CPU: 25 min at e = 1; e = 0 cost 2.4x as much as e = 1 at 1024 sliders, measured, e = 0.5 less).
     "large": Preset(
         realizations=16, steps=300, per_decade=5,
         groups=(Group("pair", "pair", (2,), ("base", "ratio0.3")),
