@@ -31,8 +31,9 @@ pair ages, with the controls that decide whether an answer is an artefact:
   and irregular 16, 64, 256 to 1e4 tau_th at ratios 0.3 and 0.2 (fewer
   realizations: 16 over 8 geometries); a second driving amplitude,
   sigma_theta / Ntilde = 10, at ratio 0.3 (the pair, chains, irregular 16
-  to 256); the e < 1 scan extended to irregular 1024, chains, lattices and
-  mu_d = 0.4; the ``large`` preset's at 4096 sliders.
+  to 256); the e < 1 scan extended to irregular 1024 (8 realizations over
+  4 geometries), chains, lattices and mu_d = 0.4; the ``large`` preset's at
+  4096 sliders.
 
 Every trend is :func:`slidernet.analysis.trend.log_trend` of a per-realization
 variable (slopes against ln t over 1 <= t <= t_end, or against the
@@ -701,7 +702,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "question": "does thermal cycling increase mu_eff with time in networks of sliders, where the pair ages?",
         "preset": name,
         "estimator": "network tilt test at every recorded time (mu_eff_at = 'records'), the same at every size; "
-                     "trends: log_trend, per-realization slopes against ln t for t >= 1; errors from independent "
+                     "trends: log_trend, per-realization slopes against ln t for t >= 1, and in the fit windows "
+                     "of 'windows' (each point's 'windows'); errors from independent "
                      "realizations, and for irregular networks from the spread of the geometries' means",
         "parameters": {key: dataclasses.asdict(p) | {"ratio": p.ratio} for key, p in PARAMS.items()},
         "preset_settings": {"realizations": preset.realizations, "steps": preset.steps,
