@@ -8,10 +8,11 @@ network tilt test at every recorded time (``mu_eff_at = "records"``, the
 same estimator at every size, the pair included), and asks it where the
 pair ages, with the controls that decide whether an answer is an artefact:
 
-* **Three parameter sets** (``PARAMS``): the base, sigma_mu / (mean - mu_d)
+* **Parameter sets** (``PARAMS``): the base, sigma_mu / (mean - mu_d)
   = 0.1 at mu_d = 0.5, and two where the pair ages: ratio 0.3 at mu_d = 0.5,
   and ratio 0.1 at mu_d = 0.4 (mean 0.6, std 0.03 and 0.02), all at
-  sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade.
+  sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade;
+  and ratio 0.2 at mu_d = 0.5 (std 0.02) for the runs to 1e4 tau_th.
 * **Sizes and geometries**: the pair, free chains of 4 and 16 (driven at
   their ends), irregular (Delaunay) networks of 16, 64, 256 and 1024 sliders
   (driven everywhere: every node of an irregular network feels the
@@ -23,16 +24,42 @@ pair ages, with the controls that decide whether an answer is an artefact:
 * **The sliding rule**: the tilt test's stricter criteria, ``[tilt]
   min_slips = 2`` and ``min_displacement = 10`` (the centre of mass moved
   by 10 reference slips within the sliding avalanche), at e = 1 and e = 0,
-  for the same sizes and ratios.
+  for the same sizes and ratios. At e = 1 the three rules are re-draws of
+  the tilt test on the same states: each makes ``[tilt] repeats = 4`` tests
+  per record (mu_eff_realization their mean, mu_eff_spread their spread).
+* **The restated study** (issue 44, item 4): the pair, chains of 4 and 16
+  and irregular 16, 64, 256 to 1e4 tau_th at ratios 0.3 and 0.2 (fewer
+  realizations: 16 over 8 geometries); a second driving amplitude,
+  sigma_theta / Ntilde = 10, at ratio 0.3 (the pair, chains, irregular 16
+  to 256); the e < 1 scan extended to irregular 1024 (8 realizations over
+  4 geometries), chains, lattices and mu_d = 0.4; the ``large`` preset's at
+  4096 sliders.
 
 Every trend is :func:`slidernet.analysis.trend.log_trend` of a per-realization
 variable (slopes against ln t over 1 <= t <= t_end, or against the
 logarithm of the slips per node); its error is from independent
 realizations and, for the irregular networks, includes the spread between
 geometries (:func:`slidernet.analysis.trend.grouped_mean_sem`: each
-geometry's mean, then the spread of the 8 means, 7 degrees of freedom). Each
-slope gets a two-sided Student-t p-value, and the family of tests a
-Benjamini-Hochberg adjustment (``scipy.stats.false_discovery_control``).
+geometry's mean, then the spread of the means, G - 1 degrees of freedom).
+The statistics (``aging_stats.py`` beside this script):
+
+* every estimator (mu_eff, ``tilt_first_slip``, ``tilt_all_moving``; both
+  estimators for the pair) in fit windows t >= 1, 10, 100 (and 1e3 in the
+  runs to 1e4) to the run's end, and from 100 slips per node on;
+* mu_eff's rate relative to its own level above mu_d
+  (:func:`~slidernet.analysis.trend.relative_rate`): the relative rate of c
+  in mu_eff = mu_d + c N^-1/2 at e = 1, of the excess at e < 1;
+* variance components of the slopes, between and within geometries
+  (:func:`~slidernet.analysis.stats.variance_components`), and each
+  geometry's slope;
+* one random-effects fit of slope(N) = a + b N^-1/2 per parameter set, rule
+  and condition (:func:`~slidernet.analysis.stats.meta_regression`);
+* beside every slope its minimum detectable effect and the two one-sided
+  tests against the margin ``MARGIN_PER_DECADE`` declared
+  before the run (a tenth of the pair's slope at ratio 0.3);
+* one family of every slope reported, Benjamini-Yekutieli (any
+  dependence; Benjamini-Hochberg beside it), and the earlier family's
+  counts (mu_eff over t >= 1, Benjamini-Hochberg).
 
 Scaled observables: sqrt(N) (mu_eff - mu_d), in which a network with an
 excess over mu_d that falls as 1/sqrt(N) is flat by construction, and
@@ -61,6 +88,7 @@ import argparse
 import dataclasses
 import json
 import math
+import sys
 import time
 import warnings
 from collections.abc import Sequence
@@ -71,24 +99,36 @@ import numpy as np
 import xarray as xr
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from scipy import stats
 
 import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
-from slidernet.analysis.trend import grouped_mean_sem, log_trend, mean_sem
+from slidernet.analysis.trend import mean_sem
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import atomic_output, save_figure, write_json
 from slidernet.plugins.distributions import mean_min_quadrature
 
 try:
-    BASE_TOML = Path(__file__).resolve().with_name("aging_networks.toml")
+    HERE = Path(__file__).resolve().parent
 except NameError:  # sphinx-gallery defines no __file__; it runs the script from examples/
-    BASE_TOML = Path("aging_networks.toml").resolve()
+    HERE = Path.cwd()
+BASE_TOML = HERE / "aging_networks.toml"
+sys.path.insert(0, str(HERE))  # the study's statistics: windows, relative rates, components, fits, the family
+import aging_stats  # noqa: E402
+from aging_stats import estimate, trend  # noqa: E402
+
 JSON_NAME = "aging_networks.json"
 PNG_NAME = "aging_networks.png"
 TABLES_NAME = "aging_networks_tables.md"  # the guide's tables, from the JSON
-LN10 = math.log(10.0)
 MU_S_MEAN = 0.6  # the law's mean before its truncation at mu_d, in every parameter set
+# The margin of "no aging", declared before the restated study's run. At ratio 0.3 the pair's mu_eff rises by
+# (94 +- 13)e-4 per decade (records' estimator, 32 realizations to 1e3 tau_th). A network whose slope is within
+# a tenth of that, +-9.4e-4 per decade, ages at most a tenth as fast as the pair, in the estimator's own units:
+# the pair's rate is known to 14 %, so a tenth of it lies 6.5 of the pair's standard errors below it; a test
+# against it passes for an error below about half the margin, as most networks' are (0.2e-4 to 7.9e-4 per
+# decade at ratio 0.3, 7 dof). Scaled variables take it in their units. The margin bounds the estimator's
+# slope, not the thresholds' aging: divided by an estimator's recovery (examples/aging_recovery.py) it bounds
+# the latter.
+MARGIN_PER_DECADE = 0.1 * 94e-4  # in mu_eff (or a tilt load) per decade of t
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,7 +144,9 @@ class Params:
         return round(self.std / (MU_S_MEAN - self.mu_d), 12)
 
 
-PARAMS = {"base": Params(0.5, 0.01), "ratio0.3": Params(0.5, 0.03), "mu_d0.4": Params(0.4, 0.02)}
+# New sets go last: a set's ensemble seed is its place in this dict.
+PARAMS = {"base": Params(0.5, 0.01), "ratio0.3": Params(0.5, 0.03), "mu_d0.4": Params(0.4, 0.02),
+          "ratio0.2": Params(0.5, 0.02)}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,6 +183,13 @@ class Group:
         Realizations per size, over all geometries (None: the preset's).
     observables : tuple of str
         Observables beside the base configuration's.
+    repeats : int
+        ``[tilt] repeats``: K independent tilt tests per record (mu_eff_realization
+        their mean, mu_eff_spread their spread).
+    amplitude : float
+        sigma_theta / Ntilde of the driver.
+    steps : int or None
+        The run's duration in tau_th (None: the preset's).
     """
 
     name: str
@@ -154,14 +203,25 @@ class Group:
     inject: tuple[float, float] | None = None
     realizations: int | None = None
     observables: tuple[str, ...] = ()
+    repeats: int = 1
+    amplitude: float = 1.0
+    steps: int | None = None
 
     def rule(self) -> str:
         """The slip and sliding rule in words (the JSON's and the figure's label)."""
         parts = [f"e = {self.overshoot:g}"]
         parts += [f"{key} = {value:g}" for key, value in self.tilt]
+        if self.repeats > 1:
+            parts.append(f"K = {self.repeats} tests")
         if self.mu_eff_at != "records":
             parts.append("the appendix's test before every rearrangement")
         return ", ".join(parts)
+
+    def condition(self) -> str:
+        """The driving and the duration where they differ from the study's (empty: sigma_theta / Ntilde = 1,
+        the preset's duration)."""
+        parts = [] if self.amplitude == 1.0 else [f"σ_θ/Ñ = {self.amplitude:g}"]
+        return ", ".join(parts + ([] if self.steps is None else [f"to {self.steps:g} τ_th"]))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -175,16 +235,54 @@ class Preset:
     mechanism: tuple[tuple[str, int], ...]  # (kind, N) at the base parameters
 
 
-def _scan(sizes: tuple[int, ...], params: tuple[str, ...], geometries: int) -> tuple[Group, ...]:
-    """The slip-rule and sliding-rule scan: the pair and irregular networks of ``sizes``, every rule."""
+def _scan(sizes: tuple[int, ...], params: tuple[str, ...], geometries: int, repeats: int = 1) -> tuple[Group, ...]:
+    """The slip-rule and sliding-rule scan: the pair and irregular networks of ``sizes``, every rule.
+
+    At e = 1 the three sliding rules are re-draws of the tilt stream on the same states (the second reading's
+    M3): they get ``repeats`` tests per record, the paper's rule included (its K = 1 reading is the study's
+    main group), so that their differences are the rules', not one draw's."""
     out = []
     rules = [(0.0, ()), (0.5, ()), (1.0, (("min_slips", 2),)), (1.0, (("min_displacement", 10.0),)),
              (0.0, (("min_slips", 2),)), (0.0, (("min_displacement", 10.0),))]
+    if repeats > 1:
+        rules.insert(2, (1.0, ()))
     for e, tilt in rules:
-        tag = f"e{e:g}" + "".join(f"_{k}{v:g}" for k, v in tilt)
-        out.append(Group(f"pair_{tag}", "pair", (2,), params, overshoot=e, tilt=tilt))
-        out.append(Group(f"irregular_{tag}", "irregular", sizes, params, geometries, overshoot=e, tilt=tilt))
+        K = repeats if e == 1.0 else 1
+        tag = f"e{e:g}" + "".join(f"_{key}{v:g}" for key, v in tilt) + (f"_K{K}" if K > 1 else "")
+        out.append(Group(f"pair_{tag}", "pair", (2,), params, overshoot=e, tilt=tilt, repeats=K))
+        out.append(Group(f"irregular_{tag}", "irregular", sizes, params, geometries, overshoot=e, tilt=tilt,
+                         repeats=K))
     return tuple(out)
+
+
+def _restated() -> tuple[Group, ...]:
+    """The groups of the restated study (issue 44, item 4), beside the study's own; realizations sized so that
+    the full preset keeps within an hour on two cores (estimates in the comments: wall time at 2 workers)."""
+    long = {"params": ("ratio0.3", "ratio0.2"), "steps": 10_000}
+    e_scan = [(e, {"overshoot": e}) for e in (0.0, 0.5)]
+    return (
+        # To 1e4 tau_th (8-10x a realization's cost, measured), N <= 256, where the pair ages (about 6 min).
+        Group("pair_1e4", "pair", (2,), **long),
+        Group("pair_appendix_1e4", "pair", (2,), mu_eff_at="rearrangements", **long),
+        Group("chains_1e4", "chain", (4, 16), **long),
+        Group("irregular_1e4", "irregular", (16, 64, 256), geometries=8, realizations=16, **long),
+        # sigma_theta / Ntilde = 10 (8-20x the cost at 64 sliders, 30x at 256), at ratio 0.3 (about 4 min).
+        Group("pair_amp10", "pair", (2,), ("ratio0.3",), amplitude=10.0),
+        Group("chains_amp10", "chain", (4, 16), ("ratio0.3",), amplitude=10.0),
+        Group("irregular_amp10", "irregular", (16, 64), ("ratio0.3",), 8, realizations=16, amplitude=10.0),
+        Group("irregular_256_amp10", "irregular", (256,), ("ratio0.3",), 4, realizations=8, amplitude=10.0),
+        # The e < 1 scan to 1024 sliders, along chains and lattices, and at mu_d = 0.4 (about 7 min; at 1024
+        # sliders e = 0 costs 2.4x as much as e = 1).
+        *(g for e, rule in e_scan for g in (
+            Group(f"irregular_1024_e{e:g}", "irregular", (1024,), ("base", "ratio0.3"), 4, realizations=8,
+                  **rule),
+            Group(f"chains_e{e:g}", "chain", (4, 16), ("base", "ratio0.3"), **rule),
+            Group(f"lattices_e{e:g}", "triangular", (4, 8, 16, 32), ("base", "ratio0.3"), realizations=16,
+                  **rule),
+            Group(f"pair_mu_d0.4_e{e:g}", "pair", (2,), ("mu_d0.4",), **rule),
+            Group(f"irregular_mu_d0.4_e{e:g}", "irregular", (16, 64, 256), ("mu_d0.4",), 8, realizations=16,
+                  **rule))),
+    )
 
 
 PRESETS = {
@@ -196,29 +294,40 @@ PRESETS = {
             Group("chains", "chain", (4, 16)),
             Group("irregular", "irregular", (16, 64, 256, 1024), geometries=8),
             Group("lattices", "triangular", (4, 8, 16, 32)),
-            *_scan((16, 64, 256), ("base", "ratio0.3"), 8),
+            # K = 4 tests per record at e = 1 (+35 % of a run's cost at 256 sliders, +51 % under
+            # min_displacement = 10, measured).
+            *_scan((16, 64, 256), ("base", "ratio0.3"), 8, repeats=4),
+            *_restated(),
         ),
         mechanism=(("pair", 2), ("chain", 16), ("irregular", 64)),
     ),
     # Beyond the full preset's budget: 4096 sliders, 8 geometries x 2 realizations to 300 tau_th, at the base
-    # and at the control where the pair ages, with the pair at the same times (about 25 min of CPU).
+    # and at the control where the pair ages, with the pair at the same times, at e = 1, 0.5 and 0 (about
+    # 2 h of CPU: 25 min at e = 1; e = 0 cost 2.4x as much as e = 1 at 1024 sliders, measured, e = 0.5 less).
     "large": Preset(
         realizations=16, steps=300, per_decade=5,
         groups=(Group("pair", "pair", (2,), ("base", "ratio0.3")),
-                Group("irregular_4096", "irregular", (4096,), ("base", "ratio0.3"), geometries=8)),
+                Group("irregular_4096", "irregular", (4096,), ("base", "ratio0.3"), geometries=8),
+                *(Group(f"{name}_e{e:g}", kind, (n,), ("base", "ratio0.3"), geometries=g, overshoot=e)
+                  for e in (0.0, 0.5) for name, kind, n, g in (("pair", "pair", 2, 1),
+                                                               ("irregular_4096", "irregular", 4096, 8)))),
         mechanism=(),
     ),
+    # To 1e3 tau_th, so that every time window exists; the restated study's kinds of group, each once.
     "quick": Preset(
-        realizations=4, steps=100, per_decade=5,
+        realizations=4, steps=1000, per_decade=5,
         groups=(
             Group("pair", "pair", (2,), ("base", "ratio0.3")),
             Group("pair_appendix", "pair", (2,), ("base",), mu_eff_at="rearrangements"),
-            Group("chains", "chain", (4,), ("base", "ratio0.3")),
+            Group("chains", "chain", (4, 8), ("base", "ratio0.3")),
             Group("irregular", "irregular", (16,), ("base", "ratio0.3"), geometries=2),
             Group("lattices", "triangular", (4,), ("base",)),
             Group("irregular_e0", "irregular", (16,), ("base",), 2, overshoot=0.0),
             Group("irregular_e0_min_slips2", "irregular", (16,), ("base",), 2, overshoot=0.0,
                   tilt=(("min_slips", 2),)),
+            Group("irregular_e1_K2", "irregular", (16,), ("base",), 2, repeats=2),
+            Group("pair_1e4", "pair", (2,), ("ratio0.2",), steps=10_000),
+            Group("chains_amp10", "chain", (4,), ("ratio0.3",), amplitude=10.0),
         ),
         mechanism=(("chain", 4),),
     ),
@@ -237,7 +346,7 @@ def point_config(group: Group, params: str, size: int, geometry: int, preset: Pr
     # Independent ensembles: a seed per parameter set and per geometry (the sizes of one sweep share it).
     cfg["seed"] = 1 + 1000 * list(PARAMS).index(params) + geometry
     cfg["realizations"] = (group.realizations or preset.realizations) // group.geometries
-    cfg["steps"] = preset.steps
+    cfg["steps"] = group.steps or preset.steps
     cfg["log_points_per_decade"] = preset.per_decade
     network: dict[str, Any] = {"kind": "chain" if group.kind == "pair" else group.kind, "Ntilde": ntilde}
     if group.kind == "triangular":
@@ -250,8 +359,8 @@ def point_config(group: Group, params: str, size: int, geometry: int, preset: Pr
     cfg["friction"] = {"mu_d": p.mu_d, "static": {"name": "gaussian", "mean": MU_S_MEAN, "std": p.std}}
     if group.overshoot != 1.0:
         cfg["friction"]["overshoot"] = group.overshoot
-    if group.tilt:
-        cfg["tilt"] = dict(group.tilt)
+    if group.tilt or group.repeats > 1:
+        cfg["tilt"] = dict(group.tilt) | ({"repeats": group.repeats} if group.repeats > 1 else {})
     if group.inject is not None:
         c, select = group.inject
         cfg["tilt"] = {**cfg.get("tilt", {}), "inject": {"c": c, "t0": 1.0, "select": select}}
@@ -259,7 +368,7 @@ def point_config(group: Group, params: str, size: int, geometry: int, preset: Pr
     if group.mu_eff_at != "records":
         cfg["mu_eff_at"] = group.mu_eff_at
         cfg["observables"] = [o for o in cfg["observables"] if o != "tilt_loads"]  # a network tilt test's
-    cfg["driver"] = {**cfg["driver"], "sigma_theta": ntilde}  # sigma_theta / Ntilde = 1
+    cfg["driver"] = {**cfg["driver"], "sigma_theta": group.amplitude * ntilde}
     return cfg
 
 
@@ -295,27 +404,6 @@ def run_sweeps(group: Group, params: str, preset: Preset, workers: int | None, s
     return merged
 
 
-def _estimate(values: np.ndarray, geometry: np.ndarray) -> dict[str, Any]:
-    """Mean, standard error (geometries' spread included), degrees of freedom and two-sided p of zero."""
-    mean, sem, dof = grouped_mean_sem(values, geometry)
-    p = float(2.0 * stats.t.sf(abs(mean / sem), dof)) if sem > 0 and dof > 0 else math.nan
-    return {"mean": mean, "sem": sem, "dof": dof, "p": p}
-
-
-def _trend(values: xr.DataArray, geometry: np.ndarray, against: xr.DataArray | None = None) -> dict[str, Any]:
-    """A per-realization variable: its value at t = 0, 1 and t_end, and its slope per decade of t (or of the
-    abscissa ``against``), each with its error from independent realizations (and geometries)."""
-    tr = log_trend(values, t_min=1, against=against)
-    v = values.transpose("realization", "t")
-    t = v["t"].values
-    out = {"t0": _estimate(v.sel(t=0).values, geometry), "t1": _estimate(v.sel(t=1).values, geometry),
-           "end": _estimate(v.isel(t=-1).values, geometry), "t_end": float(t[-1]),
-           "slope_per_decade": _estimate(LN10 * tr["slope"].values, geometry),
-           "realizations": int(tr["realizations"]),
-           "not_finite": int((~np.isfinite(v.values)).sum())}
-    return out
-
-
 def _curve(values: xr.DataArray) -> dict[str, list[float]]:
     """Mean and standard error over realizations at every recorded time (for the figure)."""
     v = values.transpose("realization", "t").values
@@ -342,15 +430,20 @@ def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry:
         "group": group.name, "kind": group.kind, "size": size, "N": N, "params": params,
         "mu_d": p.mu_d, "std": p.std, "ratio": p.ratio, "overshoot": group.overshoot,
         "tilt": dict(group.tilt), "rule": group.rule(), "geometries": group.geometries,
+        "repeats": group.repeats, "amplitude": group.amplitude, "condition": group.condition(),
         "realizations": int(ds.sizes["realization"]), "seeds": sorted({c["seed"] for c in configs}),
         "mu_s_mean": mu_s_mean,
         "r_mean": mean_sem(ds["n"].isel(t=-1).values / float(ds["t"][-1]))[0],
-        "slips_per_node_end": _estimate(slips.isel(t=-1).values, geometry),
-        "mu_eff": _trend(q, geometry),
-        "sqrtN_excess": _trend(excess, geometry),
-        "sqrtN_excess_vs_slips": _trend(excess, geometry, against=slips),
-        "law_units": _trend((q - mu_s_mean) / p.std, geometry),
-        "mu_max": _trend(ds["mu_max"], geometry),
+        "slips_per_node_end": estimate(slips.isel(t=-1).values, geometry),
+        "mu_eff": trend(q, geometry, MARGIN_PER_DECADE),
+        # The margin in each variable's unit; the slips per node grow about as t, so per decade of them too.
+        "sqrtN_excess": trend(excess, geometry, math.sqrt(N) * MARGIN_PER_DECADE),
+        "sqrtN_excess_vs_slips": trend(excess, geometry, math.sqrt(N) * MARGIN_PER_DECADE, against=slips),
+        "law_units": trend((q - mu_s_mean) / p.std, geometry, MARGIN_PER_DECADE / p.std),
+        "mu_max": trend(ds["mu_max"], geometry, MARGIN_PER_DECADE),
+        # Every estimator in every fit window; mu_eff's rate relative to its level, the variance components.
+        "windows": aging_stats.windows(ds, geometry, N, p.mu_d, group.geometries > 1,
+                                       MARGIN_PER_DECADE),
         "mu_eff_at": group.mu_eff_at,
         # The weakest link: with no prestress, the first node to yield is the weakest of N.
         "weakest_of_N": float(mean_min_quadrature(law, N)),
@@ -359,12 +452,14 @@ def reduce_point(group: Group, params: str, size: int, ds: xr.Dataset, geometry:
         "configs": configs,
     }
     if "tilt_first_slip" in ds:  # the network tilt test's loads at its first slip and first collective motion
-        point["tilt_first_slip_end"] = _estimate(ds["tilt_first_slip"].isel(t=-1).values, geometry)
-        point["tilt_all_moving_end"] = _estimate(ds["tilt_all_moving"].isel(t=-1).values, geometry)
+        point["tilt_first_slip_end"] = estimate(ds["tilt_first_slip"].isel(t=-1).values, geometry)
+        point["tilt_all_moving_end"] = estimate(ds["tilt_all_moving"].isel(t=-1).values, geometry)
         first0 = ds["tilt_first_slip"].sel(t=0).values
-        point["tilt_first_slip_t0"] = _estimate(first0, geometry)
+        point["tilt_first_slip_t0"] = estimate(first0, geometry)
         # The fresh state: the share of realizations whose first slip already set the network sliding.
         point["first_slip_slides_t0"] = float(np.mean(first0 == q.sel(t=0).values))
+    if "mu_eff_spread" in ds:  # [tilt] repeats: the spread of one realization's K tests, at t_end
+        point["mu_eff_spread_end"] = estimate(ds["mu_eff_spread"].isel(t=-1).values, geometry)
     return point
 
 
@@ -383,23 +478,6 @@ def mechanism(kind: str, N: int, preset: Preset) -> dict[str, Any]:
             out[f"{name}_{label}_mean"] = float(summary[f"{name}_mean"].isel(t=k))
             out[f"{name}_{label}_sem"] = float(summary[f"{name}_sem"].isel(t=k))
     return out
-
-
-def multiple_testing(points: list[dict[str, Any]]) -> dict[str, Any]:
-    """The family of slope tests (mu_eff per decade, every point): how many pass 2 standard errors, how many
-    would by chance, and the Benjamini-Hochberg adjusted p-values."""
-    tests = [(i, pt["mu_eff"]["slope_per_decade"]) for i, pt in enumerate(points)]
-    tests = [(i, s) for i, s in tests if math.isfinite(s["p"])]
-    ps = np.array([s["p"] for _, s in tests])
-    adjusted = stats.false_discovery_control(ps) if ps.size else ps
-    beyond_2se = sum(abs(s["mean"]) > 2 * s["sem"] for _, s in tests)
-    by_chance = sum(2 * stats.t.sf(2.0, s["dof"]) for _, s in tests)
-    for (i, _), q in zip(tests, adjusted, strict=True):
-        points[i]["mu_eff"]["slope_per_decade"]["q_bh"] = float(q)
-    return {"tests": len(tests), "beyond_2_se": int(beyond_2se), "expected_by_chance": float(by_chance),
-            "significant_at_q_0.05": int((adjusted < 0.05).sum()),
-            "method": "two-sided Student-t p-values of each slope (dof: realizations - 1, or geometries - 1); "
-                      "Benjamini-Hochberg (scipy.stats.false_discovery_control)"}
 
 
 def _pm(e: dict[str, Any], scale: float = 1.0, digits: int = 4) -> str:
@@ -423,7 +501,7 @@ def tables(data: dict[str, Any]) -> str:
     freedom in brackets; slopes per decade of t.
     """
     pts = data["points"]
-    main = [p for p in pts if p["overshoot"] == 1.0 and not p["tilt"]]
+    main = [p for p in pts if _main(p)]
     lines = ["### Every point, absolute units (1e-4 per decade)", "",
              "| network | N | σ_μ/(μ̄_s−μ_d), μ_d | estimator | R (G) | slips per node, t_end | μ_eff(0) "
              "| μ_eff(1) | μ_eff(t_end) | dμ_eff/dlog10 t (dof) | dμ_max/dlog10 t (dof) | NaN |",
@@ -449,16 +527,16 @@ def tables(data: dict[str, Any]) -> str:
             f"{_pm(lu['end'], 1, 2)} | {_slope(lu['slope_per_decade'], 1e2)} |")
     lines += ["", "### The slip rule and the sliding rule (1e-4 per decade)", "",
               "| rule | network | N | σ_μ/(μ̄_s−μ_d) | μ_eff(1) | μ_eff(t_end) | dμ_eff/dlog10 t (dof) "
-              "| d√N(μ_eff−μ_d)/dlog10 t (1e-3) | NaN |",
-              "|---|---|---|---|---|---|---|---|---|"]
+              "| d√N(μ_eff−μ_d)/dlog10 t (1e-3) | NaN | spread of the K tests, t_end |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
     for p in sorted((p for p in pts if p["mu_eff_at"] == "records" and p["params"] in ("base", "ratio0.3")
-                     and (p["kind"] in ("pair", "irregular") and p["N"] <= 256)),
+                     and not p["condition"] and (p["kind"] in ("pair", "irregular") and p["N"] <= 256)),
                     key=lambda p: (p["params"], p["N"], -p["overshoot"], sorted(p["tilt"].items()))):
         e = p["mu_eff"]
         lines.append(
             f"| {p['rule']} | {_label(p)} | {p['N']} | {p['ratio']:.1f} | {_pm(e['t1'])} | {_pm(e['end'])} | "
             f"{_slope(e['slope_per_decade'], 1e4)} | {_slope(p['sqrtN_excess']['slope_per_decade'], 1e3)} | "
-            f"{e['not_finite']} |")
+            f"{e['not_finite']} | {_pm(p['mu_eff_spread_end']) if 'mu_eff_spread_end' in p else '–'} |")
     lines += ["", "### The fresh state: the weakest link, the first slip", "",
               "| network | N | σ_μ/(μ̄_s−μ_d), μ_d | μ_eff(0) | E[min of N draws] | first slip, t = 0 "
               "| share whose first slip slides, t = 0 | first slip, t_end | all in motion, t_end |",
@@ -473,8 +551,8 @@ def tables(data: dict[str, Any]) -> str:
     fam = data["multiple_testing"]
     lines += ["", f"Multiple testing: {fam['tests']} slopes of μ_eff, {fam['beyond_2_se']} beyond 2 standard "
               f"errors, {fam['expected_by_chance']:.1f} expected by chance; "
-              f"{fam['significant_at_q_0.05']} significant at a Benjamini-Hochberg false discovery rate of 0.05.",
-              ""]
+              f"{fam['significant_at_q_0.05']} significant at a Benjamini-Hochberg false discovery rate of 0.05 "
+              "(the earlier family; the restated study's is below).", ""]
     if data["mechanism"]:
         lines += ["### Mechanism (base parameters)", "",
                   "| network | N | R | ⟨μ_s⟩ − law mean, t = 0 | same, t_end | load ratio, t_end |",
@@ -485,7 +563,9 @@ def tables(data: dict[str, Any]) -> str:
                 f"{m['mu_s_shift_t0_mean']:+.5f} ± {m['mu_s_shift_t0_sem']:.5f} | "
                 f"{m['mu_s_shift_end_mean']:+.5f} ± {m['mu_s_shift_end_sem']:.5f} | "
                 f"{m['load_ratio_end_mean']:.3f} ± {m['load_ratio_end_sem']:.3f} |")
-    return "\n".join(lines) + "\n"
+        lines.append("")
+    lines += aging_stats.tables(data, _label)
+    return "\n".join(lines)
 
 
 def _sizes_axis(ax: Any, sizes: Sequence[int]) -> None:
@@ -493,6 +573,12 @@ def _sizes_axis(ax: Any, sizes: Sequence[int]) -> None:
     ax.set_xscale("log")
     ax.set_xticks(sorted(set(sizes)), [str(n) for n in sorted(set(sizes))])
     ax.minorticks_off()
+
+
+def _main(pt: dict[str, Any]) -> bool:
+    """Whether a point is of the study's main grid: the paper's rules, sigma_theta / Ntilde = 1, the preset's
+    duration, one tilt test per record."""
+    return pt["overshoot"] == 1.0 and not pt["tilt"] and not pt["condition"] and pt["repeats"] == 1
 
 
 def _label(pt: dict[str, Any]) -> str:
@@ -507,7 +593,7 @@ def plot(data: dict[str, Any], path: Path) -> Path:
     axes = fig.subplots(2, 3)
     (ax_t, ax_s, ax_n), (ax_scaled, ax_e, ax_c) = axes
     pts = data["points"]
-    main = [p for p in pts if p["overshoot"] == 1.0 and not p["tilt"] and p["mu_eff_at"] == "records"]
+    main = [p for p in pts if _main(p) and p["mu_eff_at"] == "records"]
     base = [p for p in main if p["params"] == "base"]
     style = {"pair": "*-", "chain": "o-", "irregular": "s-", "triangular": "^--"}
     for c, p in enumerate(base):
@@ -555,11 +641,13 @@ def plot(data: dict[str, Any], path: Path) -> Path:
         (ax_c, lambda p: True, "(f) sliding rules at e = 1 and e = 0: $\\mu_\\mathrm{eff}$ at $t_\\mathrm{end}$"),
     ):
         rules = sorted({p["rule"] for p in pts if pick(p) and (p["kind"] in ("pair", "irregular"))
-                        and p["mu_eff_at"] == "records" and (ax is ax_e or p["overshoot"] in (0.0, 1.0))})
+                        and not p["condition"] and p["mu_eff_at"] == "records"
+                        and (ax is ax_e or p["overshoot"] in (0.0, 1.0))})
         for k, rule in enumerate(rules):
             for j, params in enumerate(("base", "ratio0.3")):
                 sel = sorted((p for p in pts if p["rule"] == rule and p["params"] == params and pick(p)
-                              and p["kind"] in ("pair", "irregular")), key=lambda p: p["N"])
+                              and p["kind"] in ("pair", "irregular") and not p["condition"]),
+                             key=lambda p: p["N"])
                 if not sel:
                     continue
                 n = np.array([p["N"] for p in sel], float) * (1 + 0.04 * k)
@@ -607,19 +695,24 @@ def main(argv: Sequence[str] | None = None) -> int:
                       f"{e['end']['mean']:.4f}, slope/decade {s['mean']:+.5f} +- {s['sem']:.5f} (dof {s['dof']})",
                       flush=True)
             print(f"{group.name} {params}: {time.perf_counter() - t0:.1f} s", flush=True)
-    family = multiple_testing(points)
+    fits = aging_stats.fits(points, MARGIN_PER_DECADE)
+    family = aging_stats.family(points, fits)
     mech = [mechanism(kind, N, preset) for kind, N in preset.mechanism]
     data = {
         "question": "does thermal cycling increase mu_eff with time in networks of sliders, where the pair ages?",
         "preset": name,
         "estimator": "network tilt test at every recorded time (mu_eff_at = 'records'), the same at every size; "
-                     "trends: log_trend, per-realization slopes against ln t for t >= 1; errors from independent "
+                     "trends: log_trend, per-realization slopes against ln t for t >= 1, and in the fit windows "
+                     "of 'windows' (each point's 'windows'); errors from independent "
                      "realizations, and for irregular networks from the spread of the geometries' means",
         "parameters": {key: dataclasses.asdict(p) | {"ratio": p.ratio} for key, p in PARAMS.items()},
         "preset_settings": {"realizations": preset.realizations, "steps": preset.steps,
-                            "per_decade": preset.per_decade, "sigma_theta_over_Ntilde": 1.0,
+                            "per_decade": preset.per_decade, "sigma_theta_over_Ntilde": 1.0,  # unless a group's
                             "groups": [dataclasses.asdict(g) for g in preset.groups]},
+        "windows": {"fit_windows": {k: {"t_min": t, "slips_min": m} for k, (t, m) in aging_stats.WINDOWS.items()},
+                    "margin_per_decade": MARGIN_PER_DECADE, "slips_min": aging_stats.SLIPS_MIN},
         "multiple_testing": family,
+        "fits": fits,
         "points": points,
         "mechanism": mech,
         "slidernet_version": slidernet.__version__,

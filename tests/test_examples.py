@@ -164,8 +164,9 @@ def test_aging_recovery_quick(tmp_path):
 
 
 def test_aging_networks_quick(tmp_path):
-    """The --quick preset (pair, chain 4, irregular 16 over 2 geometries, triangular 4 x 4, the overshoot and
-    a stricter sliding rule; 4 realizations; ~10 s): numbers with errors from independent units."""
+    """The --quick preset (pair, chains 4 and 8, irregular 16 over 2 geometries, triangular 4 x 4, the overshoot,
+    a stricter sliding rule, K = 2 tests, a run to 1e4, sigma_theta / Ntilde = 10; 4 realizations to 1e3 tau_th;
+    ~20 s): numbers with errors from independent units, and the restated study's statistics."""
     study, data = run_quick_study("aging_networks", tmp_path)
     preset = study.PRESETS["quick"]
     assert len(data["points"]) == sum(len(g.sizes) * len(g.params) for g in preset.groups)
@@ -176,7 +177,7 @@ def test_aging_networks_quick(tmp_path):
         # Errors from independent units: the geometries of an irregular network, else the realizations.
         assert slope["dof"] == (p["geometries"] - 1 if p["kind"] == "irregular" else preset.realizations - 1)
         assert slope["sem"] > 0 and math.isfinite(slope["mean"]) and 0 <= slope["p"] <= 1
-        assert p["mu_eff"]["t_end"] == preset.steps
+        assert p["mu_eff"]["t_end"] == p["configs"][0]["steps"] in (preset.steps, 10_000)
         # The records' estimator has a value at every time; the appendix's only where a rearrangement was.
         if p["mu_eff_at"] == "records":
             assert p["mu_eff"]["not_finite"] == 0
@@ -198,10 +199,81 @@ def test_aging_networks_quick(tmp_path):
         points[("irregular", "base", 16)]["mu_eff"]["end"]["mean"] + 0.02
     family = data["multiple_testing"]
     assert family["tests"] == len(data["points"]) and 0 <= family["beyond_2_se"] <= family["tests"]
+    check_aging_statistics(study, data)
     (mech,) = data["mechanism"]
     # At rest at t = 0 no spring is stretched: load ratio 0; thermal cycling loads the nodes.
     assert mech["load_ratio_t0_mean"] == 0.0
     assert mech["load_ratio_end_mean"] > 0.1
+
+
+def check_aging_statistics(study, data):
+    """The restated aging study's statistics (issue 44, item 4) in the --quick JSON: windows, relative rates,
+    variance components, the fits of slope(N), the new groups, and one family holding every slope reported."""
+    import numpy as np
+
+    stats = study.aging_stats
+    points = data["points"]
+    reported = []
+    for p in points:
+        reported += [p["mu_max"]["slope_per_decade"], p["sqrtN_excess_vs_slips"]["slope_per_decade"]]
+        records = p["mu_eff_at"] == "records"
+        estimators = {"mu_eff", "tilt_first_slip", "tilt_all_moving"} if records else {"mu_eff"}
+        assert set(p["windows"]) == estimators
+        for name, per_window in p["windows"].items():
+            # Every window the run covers by a decade; the later the start, the fewer the records fitted.
+            assert [w for w in stats.WINDOWS if w in per_window] == [
+                w for w, (t_min, _) in stats.WINDOWS.items() if p["mu_eff"]["t_end"] >= 10 * t_min]
+            counts = [per_window[w]["records"] for w in ("t>=100", "t>=10", "t>=1")]
+            assert counts == sorted(counts) and (p["mu_eff_at"] != "records" or counts[0] < counts[1] < counts[2])
+            for label, w in per_window.items():
+                s = w["slope_per_decade"]
+                reported.append(s)
+                if label.startswith("t") and not (p["mu_eff_at"] != "records" or name == "tilt_all_moving"):
+                    assert math.isfinite(s["mean"]) and s["sem"] > 0 and s["mde"] > 2 * s["sem"]
+                    eq = s["equivalence"]
+                    assert eq["margin"] == study.MARGIN_PER_DECADE
+                    assert eq["equivalent"] == (-eq["margin"] < eq["ci90"][0] and eq["ci90"][1] < eq["margin"])
+        for w in p["windows"]["mu_eff"].values():
+            r = w.get("relative")
+            if r is None or w["realizations"] != p["realizations"]:
+                continue
+            # The relative rate is the slope over the excess above mu_d, and c = sqrt(N) times that excess.
+            assert math.isclose(r["rate_per_decade"] * r["excess"], w["slope_per_decade"]["mean"], rel_tol=1e-9)
+            assert math.isclose(r["c"], math.sqrt(p["N"]) * r["excess"], rel_tol=1e-12)
+            c = w.get("components")
+            assert (c is not None) == (p["geometries"] > 1)
+            if c is not None and "between" in c:
+                # The components add up: between + within / n is the variance of the geometries' slopes,
+                # unless the between-geometry estimate was negative and set to 0; their mean is the slope.
+                spread = float(np.var(c["per_geometry"], ddof=1))
+                if c["between"] > 0:
+                    assert math.isclose(c["between"] + c["within"] / c["per_group"], spread, rel_tol=1e-9)
+                    assert math.isclose(c["grand_mean_sem"], w["slope_per_decade"]["sem"], rel_tol=1e-9)
+                else:
+                    assert spread <= c["within"] / c["per_group"] * (1 + 1e-9)
+                assert math.isclose(c["grand_mean"], w["slope_per_decade"]["mean"], rel_tol=1e-9)
+                assert len(c["per_geometry"]) == p["geometries"]
+    by_group = {p["group"]: p for p in points}
+    long, amp, k2 = by_group["pair_1e4"], by_group["chains_amp10"], by_group["irregular_e1_K2"]
+    assert long["mu_eff"]["t_end"] == 10_000 and "t>=1e3" in long["windows"]["mu_eff"]
+    assert long["params"] == "ratio0.2" and long["configs"][0]["friction"]["static"]["std"] == 0.02
+    driver = amp["configs"][0]["driver"]
+    assert driver["sigma_theta"] == 10 * amp["configs"][0]["network"]["Ntilde"] and amp["condition"]
+    assert k2["configs"][0]["tilt"]["repeats"] == 2 and k2["mu_eff_spread_end"]["mean"] > 0
+    # One fit of slope(N) per parameter set and rule where three sizes or more of networks were run.
+    fits = {(f["params"], f["rule"], f["window"]): f for f in data["fits"]}
+    fit = fits[("base", "e = 1", "t>=1")]
+    assert len(set(fit["sizes"])) >= 3 and fit["coef"]["infinite_N"]["mde"] > 0
+    for f in data["fits"]:
+        reported += list(f["coef"].values())
+    # The family holds every slope reported, each with its q-values, and nothing else.
+    fam = data["multiple_testing"]["family"]
+    assert fam["tests"] + fam["untestable"] == len(reported) and len(set(fam["labels"])) == fam["tests"]
+    for s in reported:
+        assert ("q_by" in s) == math.isfinite(s["p"])
+        if "q_by" in s:
+            assert s["p"] <= s["q_bh"] <= s["q_by"] <= 1
+    assert fam["method"] == "by" and "PRDS" in fam["dependence"]
 
 
 def test_creep_networks_quick(tmp_path):
