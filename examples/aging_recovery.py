@@ -1,5 +1,5 @@
 """Could the network tilt test have seen aging? A positive control at every size
-==============================================================================
+=============================================================================
 
 ``examples/aging_networks.py`` asks whether mu_eff, the network tilt test,
 rises with time in networks as it does for the pair. A "no" means something
