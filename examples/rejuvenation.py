@@ -203,7 +203,8 @@ def recovery(ds: xr.Dataset, inject: InjectConfig, N: int, t_min: float) -> dict
     for norm, r in (("contact", rate), ("mean", share * rate)):
         rec = injection_recovery(*slopes, r)
         out[norm] = {"recovery": rec.recovery, "sem": rec.recovery_sem, "dof": rec.dof, "pairs": rec.pairs,
-                     "response_per_decade": LN10 * rec.response, "response_sem_per_decade": LN10 * rec.response_sem}
+                     "response_per_decade": LN10 * rec.response,
+                     "response_sem_per_decade": LN10 * rec.response_sem}
     return out
 
 
@@ -255,7 +256,8 @@ def reduce_point(kind: str, N: int, beta: float, cycling: float, ds: xr.Dataset,
 
 
 def run_system(kind: str, N: int, beta: float, preset: Preset, workers: int | None, scheduler: str | None,
-               out: Path | None, resume: bool, select: float = 1.0) -> list[tuple[float, xr.Dataset, dict[str, Any]]]:
+               out: Path | None, resume: bool,
+               select: float = 1.0) -> list[tuple[float, xr.Dataset, dict[str, Any]]]:
     """One system at one beta and one injection over every cycling amplitude: one sweep of the [driver] table
     per duration."""
     runs = []
@@ -311,18 +313,79 @@ def tables(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _name(p: dict[str, Any]) -> str:
+    return "pair" if p["kind"] == "pair" else f"{p['kind']} {p['N']}"
+
+
+def _age_bound(edges: list[float], exact: bool) -> str:
+    """A quantile's bin [lo, hi) as "lo–hi" (hi clipped to t: then a closed bound), or "= t" where exact."""
+    lo, hi = edges
+    return f"= {lo:.3g}" if exact or lo == hi else f"{lo:.2g}–{hi:.2g}"
+
+
+def age_table(data: dict[str, Any]) -> str:
+    """The ages' tail: the bins of the 90th and 99th percentiles and of the largest age at t = 1, 10, 100 and
+    t_end, from the JSON."""
+    times = sorted({t for p in data["points"] for t in (1.0, 10.0, 100.0, p["t_end"])})
+    head = " | ".join(f"{name} at t = {t:g}" for t in times for name in ("90th", "99th", "max"))
+    lines = [f"| system | β | σ_θ/Ñ | {head} |", "|---|---|---|" + "---|" * (3 * len(times))]
+    for p in data["points"]:
+        a = p["age_quantiles"]
+        cells = []
+        for t in times:
+            if t not in a["t"]:
+                cells += ["–"] * 3
+                continue
+            i = a["t"].index(t)
+            cells += [_age_bound(a["q90"][i], False), _age_bound(a["q99"][i], False),
+                      _age_bound(a["max"][i], a["max_exact"][i])]
+        lines.append(f"| {_name(p)} | {p['beta']:g} | {p['cycling']:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def recovery_table(data: dict[str, Any]) -> str:
+    """mu_eff's recovery of the injected aging, from the JSON: select 1 at every point, and the other
+    selections where they ran (against the per-contact shift and the mean shift over the network)."""
+    selects = data["inject"]["selects"]
+    others = " | ".join(f"recovery, select {q:g}: per contact | mean shift (share)" for q in selects[1:])
+    lines = ["| system | β | σ_θ/Ñ | t_end | slope of μ_eff, plain (1e−4/decade) | response, select 1 "
+             f"(1e−4/decade) | recovery, select 1 | {others} |",
+             "|---|---|---|---|---|---|---|" + "---|---|" * (len(selects) - 1)]
+    for p in data["points"]:
+        first = p["recovery"][f"{selects[0]:g}"]
+        c = first["contact"]
+        cells = [f"{first['plain_slope_per_decade'] * 1e4:+.1f}",
+                 f"{c['response_per_decade'] * 1e4:+.1f} ± {c['response_sem_per_decade'] * 1e4:.1f}",
+                 _pm(_recovery(c), 1.0, 2)]
+        for q in selects[1:]:
+            rec = p["recovery"].get(f"{q:g}")
+            cells += (["–", "–"] if rec is None else
+                      [_pm(_recovery(rec["contact"]), 1.0, 2), f"{_pm(_recovery(rec['mean']), 1.0, 2)} "
+                                                              f"({rec['share']:.3g})"])
+        lines.append(f"| {_name(p)} | {p['beta']:g} | {p['cycling']:g} | {p['t_end']:g} | " + " | ".join(cells)
+                     + " |")
+    return "\n".join(lines) + "\n"
+
+
+def all_tables(data: dict[str, Any]) -> str:
+    """Every table of the guide, from the JSON: the full table, the ages' tail and the recovery."""
+    return (f"### Full table\n\n{tables(data)}\n### The ages' tail\n\n{age_table(data)}\n"
+            f"### Recovery of the injected aging\n\n{recovery_table(data)}")
+
+
 def plot(data: dict[str, Any], path: Path) -> Path:
-    """mu_eff(t) and the mean contact age against t: a column per beta, a line per system and amplitude."""
+    """mu_eff(t), the mean contact age and the 99th percentile of the ages against t: a column per beta, a line
+    per system and amplitude."""
     betas = sorted({p["beta"] for p in data["points"]})
-    fig = Figure(figsize=(5.0 * len(betas), 7.5), layout="constrained")
+    fig = Figure(figsize=(5.0 * len(betas), 10.5), layout="constrained")
     FigureCanvasAgg(fig)
-    axes = fig.subplots(2, len(betas), squeeze=False)
+    axes = fig.subplots(3, len(betas), squeeze=False)
     cyclings = sorted({p["cycling"] for p in data["points"]})
     styles = dict(zip(cyclings, ["-", "--", "-.", ":"], strict=False))
     systems = list(dict.fromkeys((p["kind"], p["N"]) for p in data["points"]))
     colors = {system: f"C{i}" for i, system in enumerate(systems)}  # a colour per system, a style per amplitude
     for col, beta in enumerate(betas):
-        top, bottom = axes[0, col], axes[1, col]
+        top, bottom, tail = axes[0, col], axes[1, col], axes[2, col]
         for p in (p for p in data["points"] if p["beta"] == beta):
             t = np.asarray(p["curves"]["t"], dtype=float)
             keep = t > 0
@@ -330,9 +393,13 @@ def plot(data: dict[str, Any], path: Path) -> Path:
             style = {"ls": styles[p["cycling"]], "color": colors[(p["kind"], p["N"])], "lw": 1}
             top.plot(t[keep], np.asarray(p["curves"]["mu_eff"])[keep], label=label, **style)
             bottom.plot(t[keep], np.asarray(p["curves"]["contact_age"])[keep], **style)
+            # The upper edge of the bin that holds the 99th percentile (clipped to t): a bound from above.
+            tail.plot(t[keep], np.asarray(p["age_quantiles"]["q99"])[keep, 1], **style)
         top.set(xscale="log", title=f"β = {beta:g}" + (" (no strengthening)" if beta == 0 else ""),
                 ylabel="μ_eff (network tilt test)")
-        bottom.set(xscale="log", yscale="log", xlabel="t (τ_th)", ylabel="mean contact age (τ_th)")
+        bottom.set(xscale="log", yscale="log", ylabel="mean contact age (τ_th)")
+        tail.set(xscale="log", yscale="log", xlabel="t (τ_th)")
+        tail.set_ylabel("99th percentile of the ages: its bin's upper edge (τ_th)", fontsize=8)
     axes[0, -1].legend(fontsize=6, ncol=2)
     return save_figure(fig, path)
 
@@ -395,7 +462,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     data["wall_time_s"] = time.perf_counter() - start
     print(write_json(data, args.out / JSON_NAME))
     with atomic_output(args.out / TABLES_NAME) as tmp:
-        tmp.write_text(tables(data))
+        tmp.write_text(all_tables(data))
     print(args.out / TABLES_NAME)
     print(plot(data, args.out / PNG_NAME))
     print(f"done in {time.perf_counter() - start:.1f} s")
