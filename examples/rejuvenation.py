@@ -23,6 +23,19 @@ size), the strongest threshold mu_max and the mean contact age
   seed 1 (common random numbers: realization r of every point has the same
   seed).
 
+The ages' tail: the 90th and 99th percentiles and the largest contact age
+at every recorded time, read from the histogram ``contact_age_count``
+(pooled over realizations: no error over realizations) as the bin that
+holds each (:func:`slidernet.analysis.observables.binned_quantile`).
+
+A positive control: every point also runs ``[tilt] inject = {c = 0.002,
+t0 = 1, select = 1}`` (docs/model.md, "Injected aging"), the points at
+beta = 0 again with ``select = 0.1``, and reports mu_eff's recovery of
+that known rise of the thresholds: (paired slope with injection - without)
+/ (slope of the shift c ln(1 + t / t0)), both by ``log_trend`` over the
+fit window (:func:`slidernet.analysis.trend.injection_recovery`, the
+definition of ``examples/aging_recovery.py``).
+
 Per point it reports mu_eff, mu_max and the mean contact age at t = 0, 1, 10,
 100 and 1000 (mean +- standard error over realizations), the slope of mu_eff
 per decade of t over 10 <= t <= t_end (:func:`slidernet.analysis.trend.log_trend`,
