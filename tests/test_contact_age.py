@@ -7,9 +7,12 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import slidernet
 from slidernet import kernels
+from slidernet.analysis.observables import binned_quantile
 from slidernet.config import load_config
 from slidernet.errors import ConfigError
 from slidernet.solver import Realization, Scene
@@ -167,3 +170,54 @@ def test_two_sliders_with_contact_age_run_on_the_network_kernel_and_the_pair_ker
     assert Scene.from_config(load_config(cfg)).kernel == "csr"
     with pytest.raises(ConfigError, match=r"'contact_age' observable .* needs a network kernel"):
         load_config({**cfg, "solver": {"kernel": "pair"}})
+
+
+# The fixed age bins of contact_age_count: [0, 1e-6), 4 per decade to 1e9, [1e9, inf).
+_EDGES = np.concatenate([[0.0], kernels.AGE_EDGES, [np.inf]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(ages=st.lists(st.floats(0.0, 1e4, allow_subnormal=False), min_size=1, max_size=60),
+       q=st.sampled_from([0.0, 0.1, 0.5, 0.9, 0.99, 1.0]) | st.floats(0.0, 1.0))
+def test_binned_quantile_holds_numpy_s_quantile(ages: list[float], q: float) -> None:
+    # The histogram of known ages on the fixed bins, and the exact quantile of the ages themselves.
+    counts, _ = np.histogram(ages, bins=_EDGES)
+    lo, hi = binned_quantile(counts, _EDGES[:-1], _EDGES[1:], q)
+    exact = np.quantile(ages, q, method="inverted_cdf")
+    assert lo <= exact < hi
+    # The same bin as the exact value's, not merely one that holds it.
+    assert lo == _EDGES[np.searchsorted(_EDGES, exact, side="right") - 1]
+
+
+def test_binned_quantile_of_a_run_s_histogram_per_time() -> None:
+    # 4 realizations x 6 nodes of a chain: every age at t is at most t, so the bin of the largest starts at
+    # or below t; at t = 0 every age is 0, in the first bin [0, 1e-6).
+    ds = slidernet.run(load_config(_config({"kind": "chain", "n": 6}, realizations=4)))
+    count = ds["contact_age_count"]
+    lo, hi = binned_quantile(count.values, ds["contact_age_bin"].values, ds["contact_age_upper"].values, 1.0)
+    assert lo.shape == ds["t"].shape
+    t = ds["t"].values
+    assert (lo <= t).all() and (lo[0], hi[0]) == (0.0, 1e-6)
+    # q = 0.5 never lies above q = 1.
+    lo_half, _ = binned_quantile(count.values, ds["contact_age_bin"].values, ds["contact_age_upper"].values, 0.5)
+    assert (lo_half <= lo).all()
+
+
+def test_binned_quantile_of_an_empty_histogram_is_nan() -> None:
+    lo, hi = binned_quantile([[0, 0], [1, 0]], [0.0, 1.0], [1.0, 2.0], 0.9)
+    np.testing.assert_array_equal(lo, [np.nan, 0.0])
+    np.testing.assert_array_equal(hi, [np.nan, 1.0])
+
+
+@pytest.mark.parametrize(("q", "match"), [(1.5, r"'q' parameter of binned_quantile must be in \[0, 1\]"),
+                                          (-0.1, r"must be in \[0, 1\]. Got -0.1"),
+                                          (float("nan"), "'q' parameter of binned_quantile")],
+                         ids=["above_1", "below_0", "nan"])
+def test_binned_quantile_refuses_q_outside_0_1(q: float, match: str) -> None:
+    with pytest.raises(ConfigError, match=match):
+        binned_quantile([1, 2], [0.0, 1.0], [1.0, 2.0], q)
+
+
+def test_binned_quantile_refuses_edges_that_do_not_fit_the_counts() -> None:
+    with pytest.raises(ConfigError, match=r"binned_quantile needs counts of shape \(..., B\)"):
+        binned_quantile([1, 2, 3], [0.0, 1.0], [1.0, 2.0], 0.5)

@@ -303,7 +303,10 @@ def test_rejuvenation_quick(tmp_path):
     study, data = run_quick_study("rejuvenation", tmp_path)
     preset = study.PRESETS["quick"]
     assert len(data["points"]) == len(preset.systems) * len(preset.betas) * len(preset.cycling)
-    assert (tmp_path / "rejuvenation_tables.md").read_text().count("\n") == len(data["points"]) + 2
+    text = (tmp_path / "rejuvenation_tables.md").read_text()
+    # Three tables (full, the ages' tail, the recovery), each a heading, a blank line, two header lines and a
+    # row per point.
+    assert text.count("\n| ") == 3 * (len(data["points"]) + 2) - 3 and text.count("### ") == 3
     for p in data["points"]:
         assert p["realizations"] == preset.realizations and p["t_end"] == preset.steps
         times = p["times"]
@@ -321,6 +324,34 @@ def test_rejuvenation_quick(tmp_path):
             assert 0.0 < age["mean"] < p["t_end"] and p["r_node"]["mean"] > 0
             if p["beta"] == 0.0:
                 assert times[t_end]["mu_eff"]["mean"] < times["0"]["mu_eff"]["mean"]
+        # The ages' tail, read from the pooled histogram as bins at every recorded time: ordered, and never
+        # above t; the largest is exact (t) only at a bin edge where some contact never slipped.
+        ages = p["age_quantiles"]
+        assert ages["t"] == p["curves"]["t"]
+        for i, t in enumerate(ages["t"]):
+            q90, q99, top = ages["q90"][i], ages["q99"][i], ages["max"][i]
+            assert q90[0] <= q99[0] <= top[0] <= top[1] <= t and all(lo <= hi for lo, hi in (q90, q99))
+            assert ages["max_exact"][i] == (t in (1.0, 10.0) and ages["never_slipped_share"][i] > 0)
+        # The injected aging: every point runs select = 1; select = 0.1 at the preset's select_betas only.
+        assert set(p["recovery"]) == ({"1", "0.1"} if p["beta"] in preset.select_betas else {"1"})
+        for key, rec in p["recovery"].items():
+            assert rec["select"] == float(key) and rec["c"] == study.INJECT_C
+            assert rec["contact"]["pairs"] == preset.realizations
+            assert rec["raised"] == (p["N"] if key == "1" else math.ceil(0.1 * p["N"]))
+        if p["cycling"] == 0.0:
+            # Nothing slips, the springs stand at rest: the tilt test slides at the weakest threshold, which
+            # the injection raises by exactly the shift: recovery 1 with no spread (measured to 4e-15).
+            rec = p["recovery"]["1"]["contact"]
+            assert math.isclose(rec["recovery"], 1.0, abs_tol=1e-9) and rec["sem"] < 1e-9
+            # Every contact as old as the run: the largest age is t_end's bin, and at t = 10 exactly 10.
+            i = ages["t"].index(10.0)
+            assert ages["max_exact"][i] and ages["never_slipped_share"][i] == 1.0
+    # Cycling caps the ages' tail: in the cycled irregular network 99 % of the contacts are younger than the
+    # run, by more than a bin (measured: 99th percentile in [5.6, 10) at t = 30, no contact that never slipped
+    # at t = 10).
+    cycled = next(p for p in data["points"] if (p["kind"], p["beta"], p["cycling"]) == ("irregular", 0.0, 1.0))
+    ages = cycled["age_quantiles"]
+    assert ages["q99"][-1][1] < 0.5 * cycled["t_end"] and ages["never_slipped_share"][ages["t"].index(10.0)] == 0.0
     # Cycling caps the strengthening: with beta = 0.02 the cycled irregular network ends far below the
     # uncycled one (measured 0.512 against 0.790).
     end = {(p["kind"], p["N"], p["beta"], p["cycling"]): p["times"][f"{p['t_end']:g}"]["mu_eff"]["mean"]
