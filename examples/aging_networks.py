@@ -195,7 +195,7 @@ class Group:
     name: str
     kind: str
     sizes: tuple[int, ...]
-    params: tuple[str, ...] = tuple(PARAMS)
+    params: tuple[str, ...] = ("base", "ratio0.3", "mu_d0.4")  # ratio0.2: only the long runs name it
     geometries: int = 1
     overshoot: float = 1.0
     tilt: tuple[tuple[str, float], ...] = ()
