@@ -140,10 +140,11 @@ def recover(ds: xr.Dataset, geometry: np.ndarray, inject: InjectConfig, N: int) 
         Number of sliders.
     """
     share = inject.raised(N) / N  # the mean shift over the network, per unit of the per-contact shift
-    out: dict[str, Any] = {"raised": inject.raised(N), "share": share}
+    out: dict[str, Any] = {"raised": inject.raised(N), "share": share, "rate_per_decade": {}}
     for window, t_min in WINDOWS.items():
         # The shift's own slope over the window: full recovery (near c per unit ln t for t >> t0).
         rate = float(log_trend(_shift(ds["t"], inject), t_min=t_min)["slope"][0])
+        out["rate_per_decade"][window] = LN10 * rate
         for name, (plain, injected) in ESTIMATORS.items():
             slopes = [log_trend(ds[v], t_min=t_min)["slope"].values for v in (plain, injected)]
             for norm, r in (("contact", rate), ("mean", share * rate)):
@@ -152,8 +153,6 @@ def recover(ds: xr.Dataset, geometry: np.ndarray, inject: InjectConfig, N: int) 
                     "recovery": rec.recovery, "sem": rec.recovery_sem, "dof": rec.dof, "pairs": rec.pairs,
                     "response_per_decade": LN10 * rec.response, "response_sem_per_decade": LN10 * rec.response_sem,
                     "plain_slope_per_decade": LN10 * float(np.nanmean(slopes[0]))}
-    out["rate_per_decade"] = {w: LN10 * float(log_trend(_shift(ds["t"], inject), t_min=t)["slope"][0])
-                              for w, t in WINDOWS.items()}
     return out
 
 
