@@ -28,7 +28,11 @@ two-level over network geometries where there are several
   whole), ``tilt_first_slip`` (the load at the test's first slip),
   ``tilt_all_moving`` (the load once every node has slipped in it) and
   ``mu_shs`` (the peak force of the slide-hold-slide pull, stiffness 1,
-  on the same state with the same injection).
+  on the same state with the same injection), and three readings of the
+  contacts as each breaks in the tilt test: ``tilt_contact_mean`` (the
+  mean load at which the contacts break), ``tilt_half_broken`` (the load
+  at which half of them have broken) and ``tilt_break_ratio`` (the mean
+  local ratio |F_i| / N_i under which each breaks).
 * **Systems**: ratio sigma_mu / (mean - mu_d) = 0.3 at mu_d = 0.5,
   sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade;
   the pair, free chains of 4 and 16, irregular networks of 16 and 64 (16
@@ -85,7 +89,10 @@ OVERSHOOTS = (1.0, 0.5, 0.0)
 ESTIMATORS = {"mu_eff": ("mu_eff_realization", "mu_eff_injected_realization"),
               "tilt_first_slip": ("tilt_first_slip", "tilt_first_slip_injected"),
               "tilt_all_moving": ("tilt_all_moving", "tilt_all_moving_injected"),
-              "mu_shs": ("mu_shs", "mu_shs_injected")}
+              "mu_shs": ("mu_shs", "mu_shs_injected"),
+              "tilt_contact_mean": ("tilt_contact_mean", "tilt_contact_mean_injected"),
+              "tilt_half_broken": ("tilt_half_broken", "tilt_half_broken_injected"),
+              "tilt_break_ratio": ("tilt_break_ratio", "tilt_break_ratio_injected")}
 WINDOWS = {"10-1e3": 10.0, "1-1e3": 1.0}  # t_min of each window; t_max: the run's end
 
 
@@ -169,8 +176,8 @@ def tables(data: dict[str, Any]) -> str:
         lines += [f"### Injection into {'every contact' if select == 1.0 else 'the 10 % oldest contacts'} "
                   f"(select = {select:g}), recovery of the {'shift' if select == 1.0 else 'mean shift'}", "",
                   "| e | network | N | R (G) | μ_eff, 10–1e3 | μ_eff, 1–1e3 | first slip | all moving | μ_shs "
-                  "| dμ_eff/dlog10 t, plain (1e-4) |",
-                  "|---|---|---|---|---|---|---|---|---|---|"]
+                  "| contact mean | half broken | break ratio | dμ_eff/dlog10 t, plain (1e-4) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for p in data["points"]:
             if p["select"] != select:
                 continue
@@ -179,7 +186,8 @@ def tables(data: dict[str, Any]) -> str:
                 f"| {p['overshoot']:g} | {study._label(p)} | {p['N']} | {p['realizations']} ({p['geometries']}) | "
                 f"{_pm(r[f'mu_eff|10-1e3|{norm}'])} | {_pm(r[f'mu_eff|1-1e3|{norm}'])} | "
                 f"{_pm(r[f'tilt_first_slip|10-1e3|{norm}'])} | {_pm(r[f'tilt_all_moving|10-1e3|{norm}'])} | "
-                f"{_pm(r[f'mu_shs|10-1e3|{norm}'])} | "
+                f"{_pm(r[f'mu_shs|10-1e3|{norm}'])} | {_pm(r[f'tilt_contact_mean|10-1e3|{norm}'])} | "
+                f"{_pm(r[f'tilt_half_broken|10-1e3|{norm}'])} | {_pm(r[f'tilt_break_ratio|10-1e3|{norm}'])} | "
                 f"{1e4 * r[f'mu_eff|10-1e3|{norm}']['plain_slope_per_decade']:+.1f} |")
         lines.append("")
     return "\n".join(lines)
@@ -187,7 +195,7 @@ def tables(data: dict[str, Any]) -> str:
 
 def plot(data: dict[str, Any], path: Path) -> Path:
     """Recovery against N: one panel per estimator and injection, one line per slip rule and kind."""
-    fig = Figure(figsize=(15, 6.5), layout="constrained")
+    fig = Figure(figsize=(24, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(SELECTS), len(ESTIMATORS), sharex=True, squeeze=False)
     for row, select in enumerate(SELECTS):

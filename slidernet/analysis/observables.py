@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 from slidernet._validation import check_scalar
 from slidernet.errors import ConfigError, param_error
 from slidernet.kernels.state import AGE_EDGES
+from slidernet.kernels.tilt_net import TILT_LOADS
 
 ATTRS = {
     "n": {"long_name": "cumulative number of rearrangements (slips)", "units": "1"},
@@ -41,6 +42,18 @@ ATTRS = {
     "tilt_all_moving": {"long_name": "load f + f_bar at which an avalanche of the tilt test at t first set every "
                                      "node in motion at once, above mu_d or not (the mean over the [tilt] repeats "
                                      "in which one did; NaN: none did)", "units": "1"},
+    "tilt_contact_mean": {"long_name": "mean over the contacts, weighted by their normal loads N_i, of the load "
+                                       "f + f_bar at which each contact first broke in the network tilt test at t "
+                                       "(its node's first slip; a contact intact at the test's sample at that "
+                                       "sample) (the mean over its [tilt] repeats)", "units": "1"},
+    "tilt_half_broken": {"long_name": "load f + f_bar at which the contacts broken in the network tilt test at t "
+                                      "first held half of the normal load (the mean over its [tilt] repeats)",
+                         "units": "1"},
+    "tilt_break_ratio": {"long_name": "mean over the contacts, weighted by their normal loads N_i, of the local "
+                                      "ratio |F_i| / N_i of the force on each contact to its normal load at the "
+                                      "moment it first broke in the network tilt test at t (a contact intact at "
+                                      "the test's sample: its ratio then) (the mean over its [tilt] repeats)",
+                         "units": "1"},
     "mu_eff_spread": {"long_name": "standard deviation (ddof = 1) of the realization's [tilt] repeats network "
                                    "tilt tests at t (NaN: fewer than 2 sampled)", "units": "1"},
     "contact_age": {"long_name": "mean over the nodes of the time since each node last slipped in the horizontal "
@@ -208,7 +221,7 @@ def realization_variables(records: list[Record], observables: list[str], first_r
             with np.errstate(invalid="ignore", divide="ignore"):
                 value = np.stack([r["f_sum" + suffix] for r in records]) / np.where(count > 0, count, np.nan)
             out[f"mu_eff{suffix}_realization"] = (("realization", "t"), value, attrs("mu_eff_realization"))
-        for name in ("tilt_first_slip", "tilt_all_moving", "mu_shs", "shs_travel"):
+        for name in (*TILT_LOADS, "mu_shs", "shs_travel"):
             if name + suffix in records[0]:
                 out[name + suffix] = (("realization", "t"), np.stack([r[name + suffix] for r in records]),
                                       attrs(name))

@@ -120,7 +120,23 @@ L_SHIFT = 3  # not a load: the current avalanche's displacement of the centre of
 #              (slide-hold-slide: since the pull began)
 L_PEAK = 4  # slide-hold-slide: the largest stage load so far, F / sum N + f_bar (the sample, mu_shs)
 L_TRAVEL = 5  # slide-hold-slide: not a load: the stage's travel X at that peak, Ntilde l0
-N_LOADS = 6
+# The contacts' own loads (tilt test only). A contact breaks at its node's first slip of the test, at the load
+# f + f_bar of that slip; a contact still intact when the test ends is taken to break at the end's load (under
+# the sliding rule it is unstable there: exact; at the avalanche cap: a lower bound).
+L_CONTACTS = 6  # sum of N_i times the load at which contact i broke, over the broken ones; at the end, the mean
+#                 over contacts weighted by N_i (tilt_contact_mean)
+L_BROKEN_N = 7  # not a load: sum of N_i over the broken contacts
+L_TOTAL_N = 8  # not a load: sum of N_i over all contacts
+L_HALF = 9  # the load at which the broken contacts first held half of the normal load (tilt_half_broken)
+L_RATIO = 10  # sum over the broken contacts of the force |F_i| on each as it broke (springs, external, tilt); at
+#               the end, divided by sum N_i: the mean of the local ratios |F_i| / N_i weighted by N_i
+#               (tilt_break_ratio)
+N_LOADS = 11
+
+#: The records of the ``tilt_loads`` observable and the slot of ``loads`` each is read from: the mean over a
+#: recorded time's [tilt] repeats of that load.
+TILT_LOADS = {"tilt_first_slip": L_FIRST, "tilt_all_moving": L_MOVING, "tilt_contact_mean": L_CONTACTS,
+              "tilt_half_broken": L_HALF, "tilt_break_ratio": L_RATIO}
 
 # The test's two heaps.
 _UNSTABLE = 0  # unstable nodes keyed by overload
@@ -200,6 +216,36 @@ def _stage_peak(loads, f, f_bar, pull, shift):
         loads[L_TRAVEL] = f / pull
 
 
+@kernel_jit(forceinline=True)
+def _break(loads, n, load, force):
+    """Contact of normal load ``n`` breaks at ``load`` under the force ``force`` = |F_i|: add it to the sums, and
+    note the load at which half of the normal load is first broken."""
+    loads[L_CONTACTS] += n * load
+    loads[L_RATIO] += force
+    loads[L_BROKEN_N] += n
+    # 2 x sum >= total: exact for unit loads (sums of 1.0), where half of an even N is reached exactly.
+    if math.isnan(loads[L_HALF]) and 2.0 * loads[L_BROKEN_N] >= loads[L_TOTAL_N]:
+        loads[L_HALF] = load
+
+
+@kernel_jit(forceinline=True)
+def _force(G, j, f, n):
+    """|F_j|: the force on node j at tilt f, springs, external forces and the tilt f N_j along x."""
+    Tx = G[j, 0] + f * n
+    return math.sqrt(Tx * Tx + G[j, 1] * G[j, 1])
+
+
+@kernel_jit(forceinline=True)
+def _close_contacts(loads, load, G, f, normal_load, epoch):
+    """At the test's sample ``load`` (tilt f): the contacts still intact (``epoch`` < 0) break there, under their
+    forces now; ``L_CONTACTS`` and ``L_RATIO`` become means over the contacts weighted by N_i."""
+    for j in range(epoch.size):
+        if epoch[j] < 0:
+            _break(loads, normal_load[j], load, _force(G, j, f, normal_load[j]))
+    loads[L_CONTACTS] /= loads[L_TOTAL_N]
+    loads[L_RATIO] /= loads[L_TOTAL_N]
+
+
 @kernel_jit(inline="always")
 def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, pos, av_cap, heaps, epoch, count,
                loads, slip, pull):
@@ -268,7 +314,13 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         or not (``L_MOVING``; NaN if none did: a part slid alone). They
         tell what the sample rests on: the onset of the first slip, the
         collective motion, and the rule that only motion above mu_d slides.
-        ``L_F``: the tilt f reached so far.
+        ``L_F``: the tilt f reached so far. The contacts' own loads, each
+        contact broken at its node's first slip of the test (those intact
+        at the sample at the sample's load): their mean weighted by N_i
+        (``L_CONTACTS``), the load at which the broken ones first held
+        half of the normal load (``L_HALF``), and the mean weighted by N_i
+        of the local ratio |F_i| / N_i under which each broke
+        (``L_RATIO``); NaN with ``pull`` > 0.
 
     Returns
     -------
@@ -299,9 +351,16 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         loads[L_MOVING] = math.nan
         loads[L_PEAK] = math.nan
         loads[L_TRAVEL] = math.nan
+        loads[L_HALF] = math.nan
+        loads[L_CONTACTS] = 0.0 if pull == 0.0 else math.nan
+        loads[L_RATIO] = 0.0 if pull == 0.0 else math.nan
+        loads[L_BROKEN_N] = 0.0
+        total = 0.0
         for j in range(N):
             _key(j, f, G, mu, normal_load, heaps)
             epoch[j] = -1
+            total += normal_load[j]
+        loads[L_TOTAL_N] = total
         # The pull is one count from its start: ep = 1 throughout (the tilt test's first avalanche is 1).
         ep = 1 if pull > 0.0 else 0
         slips = 0
@@ -332,6 +391,14 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
             if p_mu + 2 > tilt_mu.size or p_u + 1 > tilt_u.size:
                 return _wait_for_draws(pos, loads, R_CREEP, p_mu, p_u, f, i, ep, slips, moving, done, av_slips,
                                        shift, renewed)
+            # Both contacts are renewed: one that had not slipped (it was unstable, in motion) breaks here,
+            # under its force before the creep. epoch = ep with count 0 marks it broken and counts as no slip
+            # in this avalanche.
+            for j in range(2):
+                if epoch[j] < 0:
+                    _break(loads, normal_load[j], f + f_bar, _force(G, j, f, normal_load[j]))
+                    epoch[j] = ep
+                    count[j] = 0
             p_mu, p_u = _pair_creep(f, G, mu, f_ext, normal_load, tilt_mu, tilt_u, p_mu, p_u, heaps)
         elif stage == R_REDRAW:
             if p_mu + 1 > tilt_mu.size:
@@ -374,12 +441,15 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
         if pull == 0.0 and av_slips > av_cap:
             if f + f_bar > settings.mu_d:
                 pos[STOP] = STOP_CAP  # a sample, not of the sliding rule: the caller decides what it is worth
+                _close_contacts(loads, f + f_bar, G, f, normal_load, epoch)
                 return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
             return _give_up(pos, loads, f, STOP_PART)
         # Node i's count goes up by one; until its threshold is redrawn it counts as stable.
         c = count[i] if epoch[i] == ep else 0
         if pull > 0.0 and c == 0:
             renewed += 1
+        if pull == 0.0 and epoch[i] < 0:
+            _break(loads, normal_load[i], f + f_bar, _force(G, i, f, normal_load[i]))
         was = heaps.slot[i, _UNSTABLE] >= 0
         moving += int(_in_motion(c + 1, 1, False)) - int(_in_motion(c, 1, was))
         done += int(_in_motion(c + 1, m, False)) - int(_in_motion(c, m, was))
@@ -419,6 +489,7 @@ def _tilt_test(G, mu, f_ext, f_bar, net, settings, pair_rule, tilt_mu, tilt_u, p
                 loads[L_MOVING] = f + f_bar
             if f + f_bar > settings.mu_d:
                 if done == N and (min_shift <= 0.0 or shift >= min_shift):
+                    _close_contacts(loads, f + f_bar, G, f, normal_load, epoch)
                     return _sample(pos, loads, f, p_mu, p_u, f + f_bar)
                 # Above mu_d, the rule not yet met: the avalanche goes on, its counts kept.
                 continue

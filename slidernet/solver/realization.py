@@ -21,6 +21,7 @@ import numpy as np
 from slidernet import kernels
 from slidernet.errors import AvalancheError, SnapshotError, TiltTestError
 from slidernet.plugins.distributions import TruncatedStream
+from slidernet.kernels.tilt_net import TILT_LOADS
 from slidernet.solver.backends import backend_for
 from slidernet.solver.creep import creep_record
 from slidernet.solver.inject import injected_thresholds
@@ -107,7 +108,7 @@ class Realization:
         if scene.contact_age:
             self.out.update(contact_age=np.zeros(T), contact_age_count=np.zeros((T, kernels.N_AGE_BINS), np.int64))
         if scene.tilt_loads:
-            self.out.update(tilt_first_slip=np.full(T, np.nan), tilt_all_moving=np.full(T, np.nan))
+            self.out.update({name: np.full(T, np.nan) for name in TILT_LOADS})
         if scene.counts_capped:
             self.out["tilt_capped"] = np.zeros(T, np.int64)
         if scene.shs_stiffness is not None:
@@ -415,19 +416,20 @@ class Realization:
         if injected:
             self._store_tilt_tests(k, injected, "_injected")
 
-    def _one_tilt_test(self, mu: np.ndarray, advance: bool) -> tuple[float, bool, float, float]:
-        """(sample, met the avalanche cap before the [tilt] rule, load at the first slip, load when every node
-        first moved) of one network tilt test on the thresholds ``mu``."""
-        from slidernet.kernels.tilt_net import L_FIRST, L_MOVING, STOP, STOP_CAP
+    def _one_tilt_test(self, mu: np.ndarray, advance: bool) -> tuple[float, bool, dict[str, float]]:
+        """(sample, met the avalanche cap before the [tilt] rule, the loads of :data:`TILT_LOADS`) of one network
+        tilt test on the thresholds ``mu``."""
+        from slidernet.kernels.tilt_net import STOP, STOP_CAP
 
         f = self.tilt_test(mu, advance=advance)
         _, _, _, pos, loads = self._tilt_work
-        return f, self.scene.counts_capped and pos[STOP] == STOP_CAP, float(loads[L_FIRST]), float(loads[L_MOVING])
+        return (f, self.scene.counts_capped and pos[STOP] == STOP_CAP,
+                {name: float(loads[slot]) for name, slot in TILT_LOADS.items()})
 
-    def _store_tilt_tests(self, k: int, tests: list[tuple[float, bool, float, float]], suffix: str) -> None:
+    def _store_tilt_tests(self, k: int, tests: list[tuple[float, bool, dict[str, float]]], suffix: str) -> None:
         """Add the tests at recorded time ``k`` to the records named with ``suffix`` ("" or "_injected")."""
         out = self.out
-        sampled = [f for f, capped, _, _ in tests if not capped]
+        sampled = [f for f, capped, _ in tests if not capped]
         if self.scene.counts_capped:
             # The avalanche cap's samples, not the stricter rule's: counted, never pooled into mu_eff as the
             # rule's.
@@ -439,8 +441,8 @@ class Realization:
         if "mu_eff_spread" + suffix in out and len(sampled) > 1:
             out["mu_eff_spread" + suffix][k] = np.std(sampled, ddof=1)
         if self.scene.tilt_loads:
-            out["tilt_first_slip" + suffix][k] = _mean_of_events([first for _, _, first, _ in tests])
-            out["tilt_all_moving" + suffix][k] = _mean_of_events([moving for _, _, _, moving in tests])
+            for name in TILT_LOADS:
+                out[name + suffix][k] = _mean_of_events([loads[name] for _, _, loads in tests])
 
     def _shs_record(self, k: int) -> None:
         """The slide-hold-slide pull at recorded time ``k``, after its injected twin under ``[tilt] inject``."""
@@ -636,7 +638,7 @@ def _more_tilt_records(scene: Scene, T: int) -> dict[str, np.ndarray]:
     if scene.inject is not None and scene.tilt_at == "records":
         out.update(f_sum_injected=np.zeros(T), f_sq_injected=np.zeros(T), f_count_injected=np.zeros(T, np.int64))
         if scene.tilt_loads:
-            out.update(tilt_first_slip_injected=np.full(T, np.nan), tilt_all_moving_injected=np.full(T, np.nan))
+            out.update({name + "_injected": np.full(T, np.nan) for name in TILT_LOADS})
         if scene.counts_capped:
             out["tilt_capped_injected"] = np.zeros(T, np.int64)
     return out
