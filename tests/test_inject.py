@@ -32,6 +32,8 @@ OBSERVED = ["n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", 
 TWINS = {"mu_eff": "mu_eff_injected", "mu_eff_sem": "mu_eff_injected_sem", "mu_eff_count": "mu_eff_injected_count",
          "mu_eff_realization": "mu_eff_injected_realization", "tilt_first_slip": "tilt_first_slip_injected",
          "tilt_all_moving": "tilt_all_moving_injected", "tilt_capped": "tilt_capped_injected",
+         "tilt_contact_mean": "tilt_contact_mean_injected", "tilt_half_broken": "tilt_half_broken_injected",
+         "tilt_break_ratio": "tilt_break_ratio_injected",
          "mu_shs": "mu_shs_injected", "mu_shs_mean": "mu_shs_injected_mean", "mu_shs_sem": "mu_shs_injected_sem"}
 
 

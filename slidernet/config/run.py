@@ -172,7 +172,8 @@ class Config(_Strict):
                 raise ValueError(f"the {name!r} observable ({what}) needs a network kernel; "
                                  "use 'solver.kernel = \"auto\"' or '\"csr\"'")
         for name, what in (("mu_eff_realization", "each realization's own mu_eff"),
-                           ("tilt_loads", "the tilt test's loads at its first slip and collective motion")):
+                           ("tilt_loads", "the tilt test's loads at its first slip, collective motion and "
+                                          "contacts' breaks")):
             if name in self.observables and "mu_eff" not in self.observables:
                 raise ValueError(f"the {name!r} observable ({what}) needs the tilt tests of 'mu_eff'; add "
                                  "\"mu_eff\" to 'observables'")

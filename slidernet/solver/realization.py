@@ -20,8 +20,8 @@ import numpy as np
 
 from slidernet import kernels
 from slidernet.errors import AvalancheError, SnapshotError, TiltTestError
-from slidernet.plugins.distributions import TruncatedStream
 from slidernet.kernels.tilt_net import TILT_LOADS
+from slidernet.plugins.distributions import TruncatedStream
 from slidernet.solver.backends import backend_for
 from slidernet.solver.creep import creep_record
 from slidernet.solver.inject import injected_thresholds

@@ -214,7 +214,7 @@ class Scene:
     recompute_every: int
     slip_mode: int  # SLIP_STRAIGHT or SLIP_EXACT (solver.slip)
     catalogue: bool = False  # the kernel keeps the event catalogue (for 'events' or 'creep')
-    tilt_loads: bool = False  # the network tilt tests record their loads at the first slip and collective motion
+    tilt_loads: bool = False  # the network tilt tests record their loads (kernels.tilt_net.TILT_LOADS)
     max_events: int = 0
     contact_age: bool = False  # the network kernel keeps each node's last slip time (observable 'contact_age')
     # friction.strengthening as the kernels take it, (beta, tau_c, exponent; 0: the log law); None: off
