@@ -43,7 +43,8 @@ geometries (:func:`slidernet.analysis.trend.grouped_mean_sem`: each
 geometry's mean, then the spread of the means, G - 1 degrees of freedom).
 The statistics (``aging_stats.py`` beside this script):
 
-* every estimator (mu_eff, ``tilt_first_slip``, ``tilt_all_moving``; both
+* every estimator (mu_eff, ``tilt_first_slip``, ``tilt_all_moving``,
+  ``tilt_break_ratio``, the contacts' local ratio as each breaks; both
   estimators for the pair) in fit windows t >= 1, 10, 100 (and 1e3 in the
   runs to 1e4) to the run's end, and from 100 slips per node on;
 * mu_eff's rate relative to its own level above mu_d

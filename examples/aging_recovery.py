@@ -32,7 +32,7 @@ two-level over network geometries where there are several
   contacts as each breaks in the tilt test: ``tilt_contact_mean`` (the
   mean load at which the contacts break), ``tilt_half_broken`` (the load
   at which half of them have broken) and ``tilt_break_ratio`` (the mean
-  local ratio |F_i| / N_i under which each breaks).
+  local ratio ``|F_i| / N_i`` under which each breaks).
 * **Systems**: ratio sigma_mu / (mean - mu_d) = 0.3 at mu_d = 0.5,
   sigma_theta / Ntilde = 1, to 1e3 tau_th, 10 recorded times per decade;
   the pair, free chains of 4 and 16, irregular networks of 16 and 64 (16

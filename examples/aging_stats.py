@@ -43,9 +43,9 @@ SLIPS_MIN = 100.0
 WINDOWS = {"t>=1": (1.0, None), "t>=10": (10.0, None), "t>=100": (100.0, None), "t>=1e3": (1e3, None),
            f"s>={SLIPS_MIN:g}": (1.0, SLIPS_MIN)}
 ESTIMATORS = {"mu_eff": "mu_eff_realization", "tilt_first_slip": "tilt_first_slip",
-              "tilt_all_moving": "tilt_all_moving"}
+              "tilt_all_moving": "tilt_all_moving", "tilt_break_ratio": "tilt_break_ratio"}
 # The family's correction: Benjamini-Yekutieli, which holds under any dependence. The slopes are dependent:
-# windows of one series overlap and the three estimators read the same tests (positively), but the sizes of one
+# windows of one series overlap and the estimators read the same tests (positively), but the sizes of one
 # sweep share their ensemble seed (common random numbers of unknown sign) and the tests are two-sided, so the
 # positive regression dependence (PRDS) that Benjamini-Hochberg needs is not assured. BH is reported beside it.
 FAMILY_METHOD = "by"
