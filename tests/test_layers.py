@@ -146,3 +146,13 @@ def test_no_import_cycle_between_modules():
         if start not in state:
             visit(start, [start])
     assert not cycles, cycles
+
+
+# A module a reader can hold in mind: past this, split it by subject (ARCHITECTURE.md lists the modules).
+MAX_LINES = 800
+
+
+def test_no_module_is_over_800_lines():
+    lines = {_module_name(p): len(p.read_text(encoding="utf-8").splitlines()) for p in MODULES}
+    long = {name: n for name, n in lines.items() if n > MAX_LINES}
+    assert long == {}, f"modules over {MAX_LINES} lines (split them by subject): {long}"
