@@ -100,9 +100,9 @@ WINDOWS = {"10-1e3": 10.0, "1-1e3": 1.0}  # t_min of each window; t_max: the run
 def _systems(tag: str, inject: tuple[float, float], e: float) -> list[study.Group]:
     """The full preset's systems at one injection and one slip rule (ratio 0.3).
 
-    The rise of the 10 % oldest contacts at the paper's slip (e = 1) gets 4x the realizations: its mean shift is a tenth of the uniform one, and the recovery's error with it
-    (0.24-0.48 at 16 to 1024 irregular sliders with the base counts, up to 1.9 along chains, measured), too
-    large to tell 0.5 from 1.
+    The rise of the 10 % oldest contacts at the paper's slip (e = 1) gets 4x the realizations: its mean
+    shift is a tenth of the uniform one, and the recovery's error with it (0.24-0.48 at 16 to 1024 irregular
+    sliders with the base counts, up to 1.9 along chains, measured), too large to tell 0.5 from 1.
     """
     common = {"params": ("ratio0.3",), "overshoot": e, "inject": inject, "observables": ("mu_shs",)}
     x = 4 if (inject[1] < 1.0 and e == 1.0) else 1
