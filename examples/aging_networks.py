@@ -314,6 +314,15 @@ PRESETS = {
                                                                ("irregular_4096", "irregular", 4096, 8)))),
         mechanism=(),
     ),
+    # The study's main systems again, for the estimators added after the full run (tilt_break_ratio, the
+    # contacts' local ratio as each breaks: the one that passes the positive control of aging_recovery.py).
+    "contacts": Preset(
+        realizations=32, steps=1000, per_decade=10,
+        groups=(Group("pair", "pair", (2,)), Group("chains", "chain", (4, 16)),
+                Group("irregular", "irregular", (16, 64, 256, 1024), geometries=8),
+                Group("lattices", "triangular", (4, 8, 16, 32))),
+        mechanism=(),
+    ),
     # To 1e3 tau_th, so that every time window exists; the restated study's kinds of group, each once.
     "quick": Preset(
         realizations=4, steps=1000, per_decade=5,
