@@ -134,15 +134,19 @@ N_INTS = 13
 DUX, DUY, VX, VY, PATH, WORK = 0, 1, 2, 3, 4, 5
 N_COMP = 6
 
-# Dormand-Prince 5(4): nodes, stages and the error weights b - b_hat.
-_C = (0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0)
-_A2 = (1 / 5,)
-_A3 = (3 / 40, 9 / 40)
-_A4 = (44 / 45, -56 / 15, 32 / 9)
-_A5 = (19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729)
-_A6 = (9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656)
-_B = (35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84)
-_E = (71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40)
+# Dormand-Prince 5(4): the nodes c, the stages' weights (row 6: the 5th-order solution b, whose derivative is
+# the first stage of the next step) and the error weights b - b_hat.
+_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0],
+    [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84],
+])
+_E = np.array([71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40])
 
 
 class Motion(NamedTuple):
@@ -181,7 +185,6 @@ class Work(NamedTuple):
     Y: np.ndarray  # (N, 6) the state of M at the last accepted step
     Yt: np.ndarray  # (N, 6) a trial step
     Ks: np.ndarray  # (7, N, 6) the stages
-    Kt: np.ndarray  # (N, 6) the derivative at the end of a trial step
     cand: np.ndarray  # (N,) int64 candidates of an overload
     over: np.ndarray  # (N,) their |F| / lim
 
@@ -259,44 +262,31 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
 @kernel_jit()
 def dp_step(net, run, mo, wk, m, theta0, r, s, h):
     """One Dormand-Prince step of size h from (s, wk.Y), with wk.Ks[0] = f(s, Y): the result in wk.Yt, its
-    derivative in wk.Kt, and the error norm returned (<= 1: within the tolerance)."""
+    derivative in wk.Ks[6], and the error norm returned (<= 1: within the tolerance)."""
     Y = wk.Y
     Yt = wk.Yt
     Ks = wk.Ks
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * _A2[0] * Ks[0, k, c]
-    rhs(net, run, mo, wk, m, theta0, r, s + _C[1] * h, Yt, Ks[1])
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * (_A3[0] * Ks[0, k, c] + _A3[1] * Ks[1, k, c])
-    rhs(net, run, mo, wk, m, theta0, r, s + _C[2] * h, Yt, Ks[2])
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * (_A4[0] * Ks[0, k, c] + _A4[1] * Ks[1, k, c] + _A4[2] * Ks[2, k, c])
-    rhs(net, run, mo, wk, m, theta0, r, s + _C[3] * h, Yt, Ks[3])
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * (_A5[0] * Ks[0, k, c] + _A5[1] * Ks[1, k, c] + _A5[2] * Ks[2, k, c]
-                                      + _A5[3] * Ks[3, k, c])
-    rhs(net, run, mo, wk, m, theta0, r, s + _C[4] * h, Yt, Ks[4])
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * (_A6[0] * Ks[0, k, c] + _A6[1] * Ks[1, k, c] + _A6[2] * Ks[2, k, c]
-                                      + _A6[3] * Ks[3, k, c] + _A6[4] * Ks[4, k, c])
-    rhs(net, run, mo, wk, m, theta0, r, s + h, Yt, Ks[5])
-    for k in range(m):
-        for c in range(N_COMP):
-            Yt[k, c] = Y[k, c] + h * (_B[0] * Ks[0, k, c] + _B[2] * Ks[2, k, c] + _B[3] * Ks[3, k, c]
-                                      + _B[4] * Ks[4, k, c] + _B[5] * Ks[5, k, c])
-    rhs(net, run, mo, wk, m, theta0, r, s + h, Yt, wk.Kt)
+    for st in range(1, 7):
+        for k in range(m):
+            for c in range(N_COMP):
+                acc = 0.0
+                for j in range(st):
+                    acc += _A[st, j] * Ks[j, k, c]
+                Yt[k, c] = Y[k, c] + h * acc
+        rhs(net, run, mo, wk, m, theta0, r, s + _C[st] * h, Yt, Ks[st])
     err = 0.0
     for k in range(m):
+        # A node's error is measured against the size of its own state (displacement and velocity alike):
+        # near a stop its velocity is small, but an error of rtol times its displacement moves it by no more.
+        size = 0.0
+        for c in range(PATH):
+            size = max(size, abs(Y[k, c]), abs(Yt[k, c]))
+        scale = run.atol + run.rtol * size
         for c in range(PATH):  # the motion's components; path and work follow it
-            e = h * (_E[0] * Ks[0, k, c] + _E[2] * Ks[2, k, c] + _E[3] * Ks[3, k, c] + _E[4] * Ks[4, k, c]
-                     + _E[5] * Ks[5, k, c] + _E[6] * wk.Kt[k, c])
-            scale = run.atol + run.rtol * max(abs(Y[k, c]), abs(Yt[k, c]))
-            err = max(err, abs(e) / scale)
+            e = 0.0
+            for j in range(7):
+                e += _E[j] * Ks[j, k, c]
+            err = max(err, abs(h * e) / scale)
     return err
 
 
@@ -333,7 +323,7 @@ def _event_value(net, mo, wk, nw, kind, k, r, s):
         e, _ = watched_excess(net, mo, wk, nw, r, s, Yt)
         return e
     sp = math.hypot(Yt[k, VX], Yt[k, VY])
-    return (Yt[k, VX] * wk.Kt[k, VX] + Yt[k, VY] * wk.Kt[k, VY]) / sp if sp > 0.0 else 0.0
+    return (Yt[k, VX] * wk.Ks[6][k, VX] + Yt[k, VY] * wk.Ks[6][k, VY]) / sp if sp > 0.0 else 0.0
 
 
 @kernel_jit()
@@ -511,10 +501,10 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
             hi = -1.0
             if f_new >= 0.0:
                 hi = h
-            elif _speed_slope(Y, wk.Ks[0], k) < 0.0 < _speed_slope(wk.Yt, wk.Kt, k):
+            elif _speed_slope(Y, wk.Ks[0], k) < 0.0 < _speed_slope(wk.Yt, wk.Ks[6], k):
                 # The speed has a minimum inside the step: is it below STOP_SPEED?
                 held = locate(net, run, mo, wk, m, nw, th0, r, s, 3, k, 0.0, _speed_slope(Y, wk.Ks[0], k), h,
-                              _speed_slope(wk.Yt, wk.Kt, k))
+                              _speed_slope(wk.Yt, wk.Ks[6], k))
                 f_min = STOP_SPEED - math.hypot(wk.Yt[k, VX], wk.Yt[k, VY])
                 if f_min >= 0.0:
                     hi = held
@@ -551,7 +541,7 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
         _hold(net, run, mo, wk, m, th0, r, s, h, held)
         s = s_end if last else s + h
         _copy(wk.Yt, Y, m)
-        _copy(wk.Kt, wk.Ks[0], m)
+        _copy(wk.Ks[6], wk.Ks[0], m)
         e_old = e_new
         ints[STEPS] += 1
         for k in range(m):

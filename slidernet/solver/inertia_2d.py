@@ -125,7 +125,7 @@ class Inertia2D:
             mcol=np.zeros(nnz, np.int64), mblk=np.zeros(nnz, np.int64), wptr=np.zeros(n_nodes + 1, np.int64),
             wcol=np.zeros(nnz, np.int64), wblk=np.zeros(nnz, np.int64), F0=np.zeros((n_nodes, 2)),
             FW=np.zeros((n_nodes, 2)), Y=np.zeros((n_nodes, kern.N_COMP)), Yt=np.zeros((n_nodes, kern.N_COMP)),
-            Ks=np.zeros((7, n_nodes, kern.N_COMP)), Kt=np.zeros((n_nodes, kern.N_COMP)),
+            Ks=np.zeros((7, n_nodes, kern.N_COMP)),
             cand=np.zeros(n_nodes, np.int64), over=np.zeros(n_nodes))
         rec = scene.out_steps[scene.out_steps <= steps]
         out = kern.Out(n=np.zeros(rec.size, np.int64), mu_max=np.zeros(rec.size), x_G=np.zeros(rec.size),
