@@ -20,9 +20,9 @@ How it is integrated
 --------------------
 **Phases.** Between two events the set M of moving nodes is fixed. The
 nodes of M are integrated together, by Dormand-Prince 5(4) with adaptive
-steps (:func:`dp_step`: error per step below ``atol + rtol |y|`` in every
-component of u and v, max norm, with ``atol = 1e-2 rtol`` Ntilde l0 as the
-reference's; step at most ``max_step`` tau_dyn). Their right-hand side reads
+steps (:func:`dp_step`: error per step below ``atol + rtol |y_i|`` in every
+component of u and v of node i, |y_i| the largest of them, with ``atol =
+1e-2 rtol`` Ntilde l0 as the reference's; step at most ``max_step`` tau_dyn). Their right-hand side reads
 K only through the sparse rows of M (``K_MM``, gathered once per phase). A
 stuck node is exactly fixed: its force changes only through the moving
 nodes' displacements and theta, F_j(s) = F_j(0) - sum_{i in M} K_ji du_i(s)
@@ -44,31 +44,30 @@ state at the event is a full step of the scheme, not an interpolant, and the
 root is located to 1e-14 of the phase's time or to a zero event value.
 
 **The traps.** (1) The stop: v_i / |v_i| is singular at v_i = 0 and the
-motion near the stop chatters about it without a sign change, so the stop is
-at |v_i| = SS (the reference's rule, 1e-6 Ntilde l0 per tau_dyn: a stop
-about SS / (deceleration) ~ 1e-5 tau_dyn and SS^2 / 0.2 ~ 5e-12 Ntilde l0
-early). (2) A node that starts has |v_i| < SS: it is "armed" for a stop only
-once its speed has been above SS at the end of a step, so it is not stopped
-at once. (3) A speed that dips to a minimum inside one step and rises again
-(a node pushed on by a neighbour) shows no sign change at the step's ends:
-where d|v_i|/ds goes from < 0 to > 0 across a step, the minimum is located
-(Illinois on d|v_i|/ds) and, if it is below SS, the stop is found before it.
-(4) The start direction at v_i = 0 is F_i / |F_i|, used as the direction of
-friction until the speed is nonzero (the first stage of the first step).
-(5) Immediate restarts and simultaneous starts: after every event the
-candidates (the stopped node, the stuck neighbours of the moving set) are
-checked and every one above its threshold starts, the largest |F_j| / (mu_s,j
-N_j) first, as the reference's ``_start_overloaded``; each restart is a
-phase of its own, so a Zeno-like sequence costs one phase per restart and
-never a step of zero length.
+motion chatters about it without a sign change, so the stop is at |v_i| = SS
+(the reference's rule: ~SS / 0.1 tau_dyn and SS^2 / 0.2 Ntilde l0 early).
+(2) A node that starts has |v_i| < SS: it is armed for a stop once its speed
+has been above SS at the end of a step. (3) A speed that dips below SS and
+rises again within one step (a node pushed on by a neighbour): where d|v_i|/ds
+goes from < 0 to > 0 across a step, its minimum is located and, if below SS,
+the stop is found before it. (4) At v_i = 0 friction points along -F_i /
+|F_i|, the start direction; the first step after a start is ``H_START``.
+(5) Restarts and simultaneous starts: after every event the candidates (the
+stopped node, the stuck neighbours of M) above their thresholds start, the
+largest |F_j| / (mu_s,j N_j) first, as the reference's ``_start_overloaded``;
+each restart is a phase of its own (no step of zero length).
 
-**Energy.** Each moving node carries two more integrated components: the
-length of its path, int |v_i| ds, and the work of the thermal load on it,
-int (theta - theta(0)) g_i . v_i ds. The elastic energy E = (1/2) u.K u -
-u.f_ext changes by the exact quadratic form of each phase's displacements.
-Per avalanche (from a start with nothing moving to the next moment nothing
-moves), work = dE + sum_i mu_d N_i path_i, the kinetic energy being zero at
-both ends up to the (1/2) N_i SS^2 dropped at each stop (``avalanches``).
+**Energy.** Each moving node also integrates its path length, int |v_i| ds,
+and the work of the thermal load on it, int (theta - theta(0)) g_i . v_i ds;
+E = (1/2) u.K u - u.f_ext changes by the exact quadratic form of each phase's
+displacements. Per avalanche, work = dE + sum_i mu_d N_i path_i + the kinetic
+energy (1/2) N_i |v_i|^2 <= (1/2) N_i SS^2 dropped at each stop.
+
+**Cost.** The steps, not the operators: Dormand-Prince at rtol = 1e-10
+takes 100 to 200 steps per slip (a smooth half-oscillation needs ~100; the
+friction's direction turns ever faster as |v_i| -> 0 at a stop and from
+v_i = 0 at a start, where the steps shrink in proportion to the time to the
+stop or from the start). benchmarks/inertia_2d_speed.py measures it.
 """
 
 from __future__ import annotations
@@ -89,46 +88,27 @@ STOP_SPEED = 1e-6
 # A node that slides this long (tau_dyn) without stopping slides for ever (the reference's MAX_SLIP_DURATION).
 MAX_SLIP_DURATION = 1000.0
 
+# The first step of a phase in which a node starts from rest, tau_dyn: the controller grows it from there.
 H_START = 1e-6
 
-# Return codes of run_inertia_2d.
-DONE = 0
-NEED_MU = 1  # the threshold buffer is empty: refill it and call again
-NEED_OUT = 2  # the slip or avalanche buffer is full: empty it and call again
-RUNAWAY = 3  # a node slid MAX_SLIP_DURATION without stopping: ints[RUNAWAY_NODE] is the node
+# Return codes of run_inertia_2d: done; the threshold buffer is empty (refill it and call again); the slip or
+# avalanche buffer is full (empty it and call again); a node slid MAX_SLIP_DURATION (ints[RUNAWAY_NODE]).
+DONE, NEED_MU, NEED_OUT, RUNAWAY = 0, 1, 2, 3
+# What ended a phase: nothing (its end), a moving node's stop, a stuck node's start.
+EV_NONE, EV_STOP, EV_START = 0, 1, 2
 
-# Event kinds of a phase.
-EV_NONE = 0
-EV_STOP = 1
-EV_START = 2
-
-# Slots of the float scalars (``floats``).
-T = 0  # time, tau_th
-CLOCK = 1  # time spent in motion, tau_dyn
-STOP_MAX = 2  # the largest speed set to zero at a stop
-H = 3  # the last step size, tau_dyn (the next phase's first guess)
-AV_START = 4  # the running avalanche: its start (tau_th),
-AV_WORK = 5  # the work of the thermal load,
-AV_DISS = 6  # the friction's dissipation sum mu_d N_i path_i,
-AV_DE = 7  # the change of the elastic energy,
-AV_KE = 8  # and the kinetic energy dropped at the stops
-N_FLOATS = 9
-
-# Slots of the integer scalars (``ints``).
-Q = 0  # the thermal step being run
-STAGE = 1  # 0: t = 0 relaxation; 1: at t = q (record, then the segment); 2: inside the segment q -> q + 1
-N = 2  # rearrangements so far
-OVERLAPPING = 3  # starts while another node moved
-NEXT_OUT = 4  # the next record to write
-POS = 5  # read position in the threshold buffer
-N_SLIPS = 6  # slips written to the slip buffer
-N_AV = 7  # avalanches written to the avalanche buffer
-N_MOVING = 8
-INIT = 9  # 1 once the overloads at t = 0 were started
-AV_STARTS = 10  # starts of the running avalanche
-RUNAWAY_NODE = 11
-STEPS = 12  # accepted Dormand-Prince steps (for the benchmark)
-N_INTS = 13
+# Slots of the float scalars (``floats``): the time t (tau_th); the clock, time spent in motion (tau_dyn); the
+# largest speed set to zero at a stop; the last step (tau_dyn, the next phase's first guess); the running
+# avalanche's start (tau_th), work of the thermal load, dissipation sum mu_d N_i path_i, change of the elastic
+# energy and kinetic energy dropped at the stops.
+T, CLOCK, STOP_MAX, H, AV_START, AV_WORK, AV_DISS, AV_DE, AV_KE, N_FLOATS = range(10)
+# Slots of the integer scalars (``ints``): the thermal step q being run; the stage (0: the relaxation at t = 0;
+# 1: at t = q, its record then its segment; 2: inside the segment q -> q + 1); the rearrangements n; the starts
+# while another node moved; the next record; the read position in the threshold buffer; the rows written to
+# the slip and avalanche buffers; the number of moving nodes; 1 once the overloads at t = 0 were started; the
+# running avalanche's starts; the runaway node; the accepted steps of the scheme.
+(Q, STAGE, N, OVERLAPPING, NEXT_OUT, POS, N_SLIPS, N_AV, N_MOVING, INIT, AV_STARTS, RUNAWAY_NODE, STEPS,
+ N_INTS) = range(14)
 
 # Columns of the integrated state of a moving node.
 DUX, DUY, VX, VY, PATH, WORK = 0, 1, 2, 3, 4, 5
@@ -189,29 +169,6 @@ class Work(NamedTuple):
     over: np.ndarray  # (N,) their |F| / lim
 
 
-class Out(NamedTuple):
-    """The outputs: records at the output steps and the slip and avalanche buffers."""
-
-    n: np.ndarray  # (T,) int64
-    mu_max: np.ndarray  # (T,)
-    x_G: np.ndarray  # (T,) Ntilde l0
-    slip_f: np.ndarray  # (C, 6): start, end (tau_th), duration (tau_th), du_x, du_y, path (Ntilde l0)
-    slip_node: np.ndarray  # (C,) int64
-    av_f: np.ndarray  # (C, 6): start, end (tau_th), work, dissipation, dE, dropped kinetic energy
-    av_n: np.ndarray  # (C,) int64 starts
-
-
-class Run(NamedTuple):
-    """The run's constants."""
-
-    mu_d: float
-    tau: float  # tau_dyn / tau_th
-    rtol: float
-    atol: float
-    max_step: float  # tau_dyn
-    steps: int
-
-
 @kernel_jit()
 def node_crit(net, mo, j):
     """Recompute the stable range in theta of node j from its a_j (an undriven node: the whole line)."""
@@ -226,6 +183,18 @@ def node_crit(net, mo, j):
         mo.crit[j, 1] = up
 
 
+@kernel_jit(forceinline=True)
+def pushed(Kt, ptr, col, blk, row, Y, fx, fy):
+    """(fx, fy) less sum_p K_table[blk[p]] du_col[p] over the entries p of a gathered row (K_MM or K_WM): the
+    force on a node from the displacements Y[:, DUX:DUY + 1] of the moving nodes since the phase's start."""
+    for p in range(ptr[row], ptr[row + 1]):
+        c = col[p]
+        b = blk[p]
+        fx -= Kt[b, 0, 0] * Y[c, DUX] + Kt[b, 0, 1] * Y[c, DUY]
+        fy -= Kt[b, 1, 0] * Y[c, DUX] + Kt[b, 1, 1] * Y[c, DUY]
+    return fx, fy
+
+
 @kernel_jit()
 def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
     """out = dY/ds of the moving nodes (Y: (m, 6) local state), theta = theta0 + r s."""
@@ -234,13 +203,8 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
     th = theta0 + r * s
     for k in range(m):
         i = wk.M[k]
-        fx = wk.F0[k, 0] + net.g[i, 0] * (r * s)
-        fy = wk.F0[k, 1] + net.g[i, 1] * (r * s)
-        for p in range(wk.mptr[k], wk.mptr[k + 1]):
-            c = wk.mcol[p]
-            b = wk.mblk[p]
-            fx -= Kt[b, 0, 0] * Y[c, DUX] + Kt[b, 0, 1] * Y[c, DUY]
-            fy -= Kt[b, 1, 0] * Y[c, DUX] + Kt[b, 1, 1] * Y[c, DUY]
+        fx, fy = pushed(Kt, wk.mptr, wk.mcol, wk.mblk, k, Y, wk.F0[k, 0] + net.g[i, 0] * (r * s),
+                        wk.F0[k, 1] + net.g[i, 1] * (r * s))
         vx = Y[k, VX]
         vy = Y[k, VY]
         sp = math.hypot(vx, vy)
@@ -298,13 +262,8 @@ def watched_excess(net, mo, wk, nw, r, s, Y):
     arg = -1
     for w in range(nw):
         j = wk.W[w]
-        fx = wk.FW[w, 0] + net.g[j, 0] * (r * s)
-        fy = wk.FW[w, 1] + net.g[j, 1] * (r * s)
-        for p in range(wk.wptr[w], wk.wptr[w + 1]):
-            c = wk.wcol[p]
-            b = wk.wblk[p]
-            fx -= Kt[b, 0, 0] * Y[c, DUX] + Kt[b, 0, 1] * Y[c, DUY]
-            fy -= Kt[b, 1, 0] * Y[c, DUX] + Kt[b, 1, 1] * Y[c, DUY]
+        fx, fy = pushed(Kt, wk.wptr, wk.wcol, wk.wblk, w, Y, wk.FW[w, 0] + net.g[j, 0] * (r * s),
+                        wk.FW[w, 1] + net.g[j, 1] * (r * s))
         e = math.hypot(fx, fy) - mo.lim[j]
         if e > best:
             best = e
@@ -322,8 +281,7 @@ def _event_value(net, mo, wk, nw, kind, k, r, s):
     if kind == EV_START:
         e, _ = watched_excess(net, mo, wk, nw, r, s, Yt)
         return e
-    sp = math.hypot(Yt[k, VX], Yt[k, VY])
-    return (Yt[k, VX] * wk.Ks[6][k, VX] + Yt[k, VY] * wk.Ks[6][k, VY]) / sp if sp > 0.0 else 0.0
+    return _speed_slope(Yt, wk.Ks[6], k)
 
 
 @kernel_jit()
@@ -407,24 +365,20 @@ def driven_crossing(mo, theta, r):
     """The first stuck, unwatched node whose |F_j| reaches its threshold as theta moves from ``theta`` at
     rate r (any unit of time): (wait in that unit, node), or (inf, -1). Its stable range ``crit`` is exact for
     such a node (its a_j is fixed)."""
+    if r == 0.0:
+        return math.inf, -1
+    # Rising theta leaves the range at theta_up, falling at theta_dn: both as a minimum of side * crit.
+    col = 1 if r > 0.0 else 0
+    side = 1.0 if r > 0.0 else -1.0
     best = math.inf
     arg = -1
-    if r > 0.0:
-        for j in range(mo.moving.size):
-            if mo.moving[j] == 0 and mo.wmark[j] < 0 and mo.crit[j, 1] < best:
-                best = mo.crit[j, 1]
-                arg = j
-        if arg >= 0:
-            return max((best - theta) / r, 0.0), arg
-    elif r < 0.0:
-        best = -math.inf
-        for j in range(mo.moving.size):
-            if mo.moving[j] == 0 and mo.wmark[j] < 0 and mo.crit[j, 0] > best:
-                best = mo.crit[j, 0]
-                arg = j
-        if arg >= 0:
-            return max((best - theta) / r, 0.0), arg
-    return math.inf, -1
+    for j in range(mo.moving.size):
+        if mo.moving[j] == 0 and mo.wmark[j] < 0 and side * mo.crit[j, col] < best:
+            best = side * mo.crit[j, col]
+            arg = j
+    if arg < 0:
+        return math.inf, -1
+    return max((side * best - theta) / r, 0.0), arg
 
 
 @kernel_jit()
@@ -459,12 +413,10 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
     Y = wk.Y
     for k in range(m):
         i = wk.M[k]
-        Y[k, DUX] = 0.0
-        Y[k, DUY] = 0.0
+        for c in range(N_COMP):
+            Y[k, c] = 0.0
         Y[k, VX] = mo.v[i, 0]
         Y[k, VY] = mo.v[i, 1]
-        Y[k, PATH] = 0.0
-        Y[k, WORK] = 0.0
     th0 = theta0 - theta_ref
     rhs(net, run, mo, wk, m, th0, r, 0.0, Y, wk.Ks[0])
     e_old = -math.inf
@@ -587,14 +539,8 @@ def _commit(net, run, mo, wk, floats, m, nw, theta_ref):
         dux = Y[k, DUX]
         duy = Y[k, DUY]
         # E = u.K u / 2 - u.f_ext, and f_ext - K u = a + g theta(0): dE = -du.(a + g theta(0)) + du.K du / 2.
-        kx = 0.0
-        ky = 0.0
-        for p in range(wk.mptr[k], wk.mptr[k + 1]):
-            c = wk.mcol[p]
-            b = wk.mblk[p]
-            kx += Kt[b, 0, 0] * Y[c, DUX] + Kt[b, 0, 1] * Y[c, DUY]
-            ky += Kt[b, 1, 0] * Y[c, DUX] + Kt[b, 1, 1] * Y[c, DUY]
-        dE += (0.5 * (dux * kx + duy * ky) - dux * (mo.a[i, 0] + net.g[i, 0] * theta_ref)
+        kx, ky = pushed(Kt, wk.mptr, wk.mcol, wk.mblk, k, Y, 0.0, 0.0)  # -(K_MM du)_i
+        dE += (-0.5 * (dux * kx + duy * ky) - dux * (mo.a[i, 0] + net.g[i, 0] * theta_ref)
                - duy * (mo.a[i, 1] + net.g[i, 1] * theta_ref))
         floats[AV_WORK] += Y[k, WORK]
         floats[AV_DISS] += run.mu_d * net.normal_load[i] * Y[k, PATH]
@@ -627,10 +573,8 @@ def start(net, mo, wk, floats, ints, i, theta):
         ints[OVERLAPPING] += 1
     else:
         floats[AV_START] = floats[T]
-        floats[AV_WORK] = 0.0
-        floats[AV_DISS] = 0.0
-        floats[AV_DE] = 0.0
-        floats[AV_KE] = 0.0
+        for f in range(AV_WORK, AV_KE + 1):
+            floats[f] = 0.0
         ints[AV_STARTS] = 0
     ints[AV_STARTS] += 1
     ints[N] += 1
@@ -677,8 +621,7 @@ def start_overloaded(net, mo, wk, floats, ints, nc, theta):
 
 @kernel_jit()
 def start_overloaded_all(net, mo, wk, floats, ints, theta):
-    """:func:`start_overloaded` over every stuck node outside its stable range at theta (or every node where
-    theta is not finite... never: the candidates are read from ``crit``, and checked by the force itself)."""
+    """:func:`start_overloaded` over the stuck nodes outside their stable range ``crit`` at theta."""
     nc = 0
     for j in range(mo.moving.size):
         if mo.moving[j] == 0 and not (mo.crit[j, 0] <= theta <= mo.crit[j, 1]):
@@ -733,10 +676,8 @@ def after_phase(net, run, mo, wk, out, floats, ints, mu_buf, event, node, nw, th
         a = ints[N_AV]
         out.av_f[a, 0] = floats[AV_START]
         out.av_f[a, 1] = floats[T]
-        out.av_f[a, 2] = floats[AV_WORK]
-        out.av_f[a, 3] = floats[AV_DISS]
-        out.av_f[a, 4] = floats[AV_DE]
-        out.av_f[a, 5] = floats[AV_KE]
+        for f in range(4):  # work, dissipation, dE, dropped kinetic energy
+            out.av_f[a, 2 + f] = floats[AV_WORK + f]
         out.av_n[a] = ints[AV_STARTS]
         ints[N_AV] = a + 1
 
@@ -753,12 +694,20 @@ def _room(out, ints, mu_buf):
 
 @kernel_jit()
 def _runaway(mo, wk, floats, ints):
-    """The first moving node that has slid MAX_SLIP_DURATION tau_dyn, or -1."""
+    """RUNAWAY, with the node in ints[RUNAWAY_NODE], if a moving node has slid MAX_SLIP_DURATION tau_dyn."""
     for k in range(ints[N_MOVING]):
-        i = wk.M[k]
-        if floats[CLOCK] - mo.start_clock[i] >= MAX_SLIP_DURATION:
-            return i
-    return -1
+        if floats[CLOCK] - mo.start_clock[wk.M[k]] >= MAX_SLIP_DURATION:
+            ints[RUNAWAY_NODE] = wk.M[k]
+            return RUNAWAY
+    return DONE
+
+
+@kernel_jit()
+def _next_step(floats, ints, q):
+    """The segment q -> q + 1 is over: t = q + 1, whose record comes next."""
+    floats[T] = float(q + 1)
+    ints[Q] = q + 1
+    ints[STAGE] = 1
 
 
 @kernel_jit()
@@ -778,18 +727,17 @@ def run_inertia_2d(thetas, out_steps, net, mo, wk, out, run, floats, ints, mu_bu
             if ints[INIT] == 0:
                 start_overloaded_all(net, mo, wk, floats, ints, theta_ref)
                 ints[INIT] = 1
-            if ints[N_MOVING] > 0:
-                code = _room(out, ints, mu_buf)
-                if code != DONE:
-                    return code
+            if ints[N_MOVING] == 0:
+                ints[STAGE] = 1
+                continue
+            code = _room(out, ints, mu_buf)
+            if code == DONE:
                 _, event, node, nw = phase(net, run, mo, wk, floats, ints, theta_ref, theta_ref, 0.0,
                                            MAX_SLIP_DURATION)
                 after_phase(net, run, mo, wk, out, floats, ints, mu_buf, event, node, nw, theta_ref)
-                ints[RUNAWAY_NODE] = _runaway(mo, wk, floats, ints)
-                if ints[RUNAWAY_NODE] >= 0:
-                    return RUNAWAY
-                continue
-            ints[STAGE] = 1
+                code = _runaway(mo, wk, floats, ints)
+            if code != DONE:
+                return code
             continue
         q = ints[Q]
         if stage == 1:
@@ -820,16 +768,14 @@ def run_inertia_2d(thetas, out_steps, net, mo, wk, out, run, floats, ints, mu_bu
             s1, event, node, nw = phase(net, run, mo, wk, floats, ints, theta, theta_ref, rate * tau,
                                         min(left, MAX_SLIP_DURATION))
             if event == EV_NONE and s1 >= left:
-                floats[T] = float(q + 1)
-                ints[Q] = q + 1
-                ints[STAGE] = 1
+                _next_step(floats, ints, q)
                 continue
             floats[T] = t + tau * s1
             after_phase(net, run, mo, wk, out, floats, ints, mu_buf, event, node, nw,
                         theta_a + rate * (floats[T] - q))
-            ints[RUNAWAY_NODE] = _runaway(mo, wk, floats, ints)
-            if ints[RUNAWAY_NODE] >= 0:
-                return RUNAWAY
+            code = _runaway(mo, wk, floats, ints)
+            if code != DONE:
+                return code
         else:
             # Nothing moves: theta drives F through g, and the next start is a root in closed form,
             # inclusive at the end of the segment (the solver's eq. `critique`).
@@ -837,9 +783,7 @@ def run_inertia_2d(thetas, out_steps, net, mo, wk, out, run, floats, ints, mu_bu
             if j >= 0:
                 wait = _wait_of(net, mo, j, theta, rate)
             if j < 0 or t + wait > q + 1:
-                floats[T] = float(q + 1)
-                ints[Q] = q + 1
-                ints[STAGE] = 1
+                _next_step(floats, ints, q)
                 continue
             floats[T] = t + wait
             theta = theta_a + rate * (floats[T] - q)

@@ -11,6 +11,7 @@ scheme are in the kernel's module docstring.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -26,6 +27,30 @@ OUT_CHUNK = 4096
 # 1e-2 RTOL in Ntilde l0, as the reference's), steps of at most MAX_STEP tau_dyn.
 RTOL = 1e-10
 MAX_STEP = 0.1
+
+
+class Out(NamedTuple):
+    """What :func:`~slidernet.kernels.inertia_2d.run_inertia_2d` writes: the records at the output steps, the
+    slip and avalanche buffers."""
+
+    n: np.ndarray  # (T,) int64
+    mu_max: np.ndarray  # (T,)
+    x_G: np.ndarray  # (T,) Ntilde l0
+    slip_f: np.ndarray  # (C, 6): start, end (tau_th), duration (tau_th), du_x, du_y, path (Ntilde l0)
+    slip_node: np.ndarray  # (C,) int64
+    av_f: np.ndarray  # (C, 6): start, end (tau_th), work, dissipation, dE, dropped kinetic energy
+    av_n: np.ndarray  # (C,) int64 starts
+
+
+class Run(NamedTuple):
+    """The run's constants, as the kernel reads them."""
+
+    mu_d: float
+    tau: float  # tau_dyn / tau_th
+    rtol: float
+    atol: float
+    max_step: float  # tau_dyn
+    steps: int
 
 
 class Inertia2D:
@@ -128,10 +153,10 @@ class Inertia2D:
             Ks=np.zeros((7, n_nodes, kern.N_COMP)),
             cand=np.zeros(n_nodes, np.int64), over=np.zeros(n_nodes))
         rec = scene.out_steps[scene.out_steps <= steps]
-        out = kern.Out(n=np.zeros(rec.size, np.int64), mu_max=np.zeros(rec.size), x_G=np.zeros(rec.size),
+        out = Out(n=np.zeros(rec.size, np.int64), mu_max=np.zeros(rec.size), x_G=np.zeros(rec.size),
                        slip_f=np.zeros((OUT_CHUNK, 6)), slip_node=np.zeros(OUT_CHUNK, np.int64),
                        av_f=np.zeros((OUT_CHUNK, 6)), av_n=np.zeros(OUT_CHUNK, np.int64))
-        run = kern.Run(mu_d=float(scene.mu_d), tau=self.tau_ratio, rtol=self.rtol, atol=1e-2 * self.rtol,
+        run = Run(mu_d=float(scene.mu_d), tau=self.tau_ratio, rtol=self.rtol, atol=1e-2 * self.rtol,
                        max_step=self.max_step, steps=int(steps))
         floats = np.zeros(kern.N_FLOATS)
         floats[kern.H] = min(0.01, self.max_step)
