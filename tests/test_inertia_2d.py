@@ -149,6 +149,23 @@ def test_counts_add_up(seed: int) -> None:
     assert out["mu_max"][0] == draws.initial.max()
 
 
+def test_refills_change_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The kernel returns whenever a buffer is full or empty and resumes where it was: thresholds in batches of
+    2 (solver.batch) and slip and avalanche buffers of 3 rows give the run of the defaults, bit for bit."""
+    cfg = {"steps": 2, "record": "all", "friction": FRICTION,
+           "network": dict(IRREGULAR, Ntilde=Ntilde), "driver": {"name": "gaussian_steps", "sigma_theta": Ntilde}}
+    out = Inertia2D(Scene.from_config(load_config(cfg)), tau_ratio=1e-3).run(np.random.SeedSequence(0))
+    monkeypatch.setattr("slidernet.solver.inertia_2d.OUT_CHUNK", 3)
+    small = Scene.from_config(load_config({**cfg, "solver": {"batch": 2}}))
+    again = Inertia2D(small, tau_ratio=1e-3).run(np.random.SeedSequence(0))
+    assert out["slips"]["node"].size > 100
+    for key in ("n", "mu_max", "x_G"):
+        assert np.array_equal(out[key], again[key])
+    for part in ("slips", "avalanches"):
+        for key, value in out[part].items():
+            assert np.array_equal(value, again[part][key]), (part, key)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
