@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from slidernet.config import load_config
-from slidernet.errors import ConfigError
+from slidernet.errors import AvalancheError, ConfigError
 from slidernet.kernels import inertia_2d as kern
 from slidernet.model.network import Network
 from slidernet.solver import Scene
@@ -220,6 +220,14 @@ def test_refills_change_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_bad_arguments(kwargs: dict[str, Any], match: str) -> None:
     with pytest.raises(ConfigError, match=match):
         Inertia2D(scene(), **kwargs)
+
+
+def test_a_load_friction_cannot_hold_is_refused() -> None:
+    """Two sliders pushed together along x by 0.7 N each (above mu_s and mu_d) slide for ever: the run stops
+    after MAX_SLIP_DURATION tau_dyn of motion with the reference's AvalancheError."""
+    net = Network([[0.0, 0.0], [1.0, 0.0]], [[0, 1]], Ntilde, f_ext=np.array([[0.7, 0.0], [0.7, 0.0]]))
+    with pytest.raises(AvalancheError, match=r"Node [01] has been sliding for 1000 tau_dyn without stopping"):
+        Inertia2D(scene(network=net), tau_ratio=1e-4).run(np.random.SeedSequence(0))
 
 
 def test_1d_scene_is_refused() -> None:
