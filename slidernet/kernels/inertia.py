@@ -1,0 +1,899 @@
+"""The equations of motion of a 1D network with inertia, event-driven and exact between events.
+
+This is the compiled twin of the reference integrator
+(:mod:`slidernet.validation.dynamics`): the same equations, the same stick,
+start, stop and restart rules, the same order of threshold draws, the same
+counting (one rearrangement per start of motion). Units are the kernels':
+u in Ntilde l0, theta in Ntilde, forces in N, K in k0, and during motion
+the local time s = (t - t_0) / tau_dyn, in which node i (mass N_i) obeys
+
+    N_i d^2u_i/ds^2 = F_i - mu_d N_i sigma_i,    F = -K u + (theta - theta(0)) g + f_ext,
+
+with sigma_i = +-1 the sign of its motion (the sign of F_i when it started).
+
+**A phase** is a stretch of time in which the set M of moving nodes and
+their signs do not change and theta is linear in s (inside one driver
+step): theta = theta_0 + r s. Stuck nodes are exactly fixed, so with
+y = u_M - u_M(0) the motion is the linear system
+
+    N_M y'' = -K_MM y + b + c s,    b = F_M(0) - mu_d N_M sigma_M,    c = r g_M,
+
+y(0) = 0, y'(0) = v_M(0). With the generalized modes of (K_MM, N_M),
+K_MM phi_k = lambda_k N_M phi_k, phi_k^T N_M phi_k = 1 (from the symmetric
+N^-1/2 K_MM N^-1/2 = Q diag(lambda) Q^T by Jacobi rotations, phi = N^-1/2 Q),
+the modal amplitudes a = phi^T N_M y obey a_k'' = -lambda_k a_k + beta_k +
+gamma_k s (beta = phi^T b, gamma = phi^T c), so that
+
+    a_k(s) = a'_k(0) C1 + beta_k C2 + gamma_k C3,   a'_k = a'_k(0) C0 + beta_k C1 + gamma_k C2,
+
+with C0 = cos(w s), C1 = sin(w s) / w, C2 = (1 - cos w s) / lambda,
+C3 = (s - sin(w s) / w) / lambda, w = sqrt(lambda) (:func:`basis`; their
+Taylor series near lambda s^2 = 0, a rigid mode included). Each C_{n+1} is
+the integral of C_n from 0, which is how the work of the drive is integrated.
+
+**Events** end a phase: a moving node's velocity returns to zero (the root
+of sigma_i v_i(s), falling), a stuck node's |F_j(s)| reaches mu_s,j N_j
+(rising), or the end of the driver step. A lone moving node (one mode) has
+its stop in closed form: sigma v(s) = P cos(w s) + Q sin(w s) + R. A stuck
+node that no moving node touches sees a force linear in s (closed form).
+The other stuck nodes are first bounded over the phase (each modal
+amplitude is at most |P_k| + |R_k| s + hypot(U_k, V_k)); only those that the
+bound cannot clear, and the stops of a moving segment of several nodes,
+are watched by sampling at ``SAMPLE`` / w_max tau_dyn (well below the
+shortest period 2 pi / w_max), where each interval is checked for a sign
+change and, from the derivatives at its ends, for an extremum that dips
+through zero inside it; the root is then polished by a bracketed Newton
+iteration to a few ulps. Stuck nodes never move; only their thresholds are
+watched.
+
+**The traps.** A node starts along F_j (sigma_j = sign F_j) with v = 0; at
+s = 0 of the next phase its stop function is 0 and rising, so the search
+skips it there (the reference's placeholder). A node that stops and finds
+|F_i| above its redrawn threshold starts again at once (a new
+rearrangement); stuck nodes above their thresholds start, the largest
+overload first, one by one (simultaneous starts), each counted. A moving
+node found a hair past its stop at s = 0 (rounding after another node's
+event) stops at s = 0, so a sign never flips under the friction
+(chattering).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from slidernet.kernels.jit import kernel_jit
+from slidernet.kernels.state import DONE, NEED_EVENTS, NEED_MU
+
+# Return codes besides DONE, NEED_MU and NEED_EVENTS (a log is full): a node slid this long.
+RUNAWAY = 8
+
+# A node that slides this long (in tau_dyn) without its velocity ever returning to zero is sliding for ever
+# (the reference's MAX_SLIP_DURATION).
+MAX_SLIP_DURATION = 1000.0
+# The watch's sampling step, in 1 / w_max tau_dyn (w_max the highest modal frequency): 1/5 of a radian,
+# 31 samples per shortest period; at most MAX_SAMPLE tau_dyn where every mode is (nearly) rigid.
+SAMPLE = 0.2
+MAX_SAMPLE = 0.2
+# Below this lambda s^2 the basis functions are summed from their Taylor series (to the x^6 term: the
+# first term left out is below 1e-16 of the sum).
+TAYLOR = 0.25
+
+# Integer scalars (istate) and float scalars (fstate) of a realization.
+I_STAGE, I_Q, I_REC, I_N, I_OVERLAP, I_SLIPS, I_POS, I_NODE, I_AVAL, I_AV_START = range(10)
+F_T, F_CLOCK, F_STOP_SPEED, F_WORK, F_E0, F_T0 = range(6)
+# Stages of the loop, resumable at each: relax the initial overload, record step q, run step q.
+STAGE_OVERLOAD, STAGE_RELAX, STAGE_RECORD, STAGE_STEP = range(4)
+# What ended a phase.
+NO_EVENT, STOP, START = range(3)
+
+
+class Motion(NamedTuple):
+    """The nodes' state, shape (N,) each: displacements ``u`` (Ntilde l0), velocities ``v`` (Ntilde l0 per
+    tau_dyn), signs of motion ``sig``, thresholds ``mu`` and ``lim`` = mu N_i, ``moving`` (1 or 0), and
+    the start of each node's current motion: ``start_t`` (tau_th), ``start_clock`` (tau_dyn), ``start_u``."""
+
+    u: np.ndarray
+    v: np.ndarray
+    sig: np.ndarray
+    mu: np.ndarray
+    lim: np.ndarray
+    moving: np.ndarray
+    start_t: np.ndarray
+    start_clock: np.ndarray
+    start_u: np.ndarray
+
+
+class Work(NamedTuple):
+    """Scratch of one phase, sized for N nodes: ``M`` the moving nodes, ``W`` the watched stuck ones
+    (``where`` maps a node to its place in M, -1 - its place in W, or N when in neither); ``Kmm`` (N, N)
+    K_MM then its rotations, ``Q`` (N, N) the modes, ``KWM`` (N, N) the rows K_WM; per mode ``lam``,
+    ``ap0``, ``beta``, ``gamma``; per moving node ``rootN`` = sqrt(N_i), ``F0``, ``y``, ``yv``, ``ya``;
+    per watched node ``FW``, ``dW`` (its drive) and ``watch`` (1: sampled); ``ev`` (6, 2 N) the event
+    functions of the search (values and slopes at two samples, curvature bounds, safe steps)."""
+
+    M: np.ndarray
+    W: np.ndarray
+    where: np.ndarray
+    Kmm: np.ndarray
+    Q: np.ndarray
+    KWM: np.ndarray
+    lam: np.ndarray
+    ap0: np.ndarray
+    beta: np.ndarray
+    gamma: np.ndarray
+    rootN: np.ndarray
+    F0: np.ndarray
+    y: np.ndarray
+    yv: np.ndarray
+    ya: np.ndarray
+    FW: np.ndarray
+    dW: np.ndarray
+    watch: np.ndarray
+    ev: np.ndarray
+
+
+class Log(NamedTuple):
+    """What a run writes: the records at the recorded steps (``out_n``, ``out_mu_max``, ``out_xg``); one
+    row per slip that came to rest (``slip_start``, ``slip_end`` in tau_th, ``slip_duration`` in tau_th,
+    ``slip_node``, ``slip_du`` in Ntilde l0); one row per avalanche from rest to rest (``av_start``,
+    ``av_end`` in tau_th, ``av_work`` the work of the loads f_ext + (theta - theta(0)) g on the motion,
+    ``av_e0`` and ``av_e1`` the elastic energy u.K u / 2 before and after, in N Ntilde l0)."""
+
+    out_n: np.ndarray
+    out_mu_max: np.ndarray
+    out_xg: np.ndarray
+    slip_start: np.ndarray
+    slip_end: np.ndarray
+    slip_duration: np.ndarray
+    slip_node: np.ndarray
+    slip_du: np.ndarray
+    av_start: np.ndarray
+    av_end: np.ndarray
+    av_work: np.ndarray
+    av_e0: np.ndarray
+    av_e1: np.ndarray
+
+
+def new_work(n: int) -> Work:
+    """Scratch for a network of ``n`` nodes."""
+    f = np.zeros
+    return Work(M=np.zeros(n, np.int64), W=np.zeros(n, np.int64), where=np.full(n, n, np.int64),
+                Kmm=f((n, n)), Q=f((n, n)), KWM=f((n, n)), lam=f(n), ap0=f(n), beta=f(n), gamma=f(n),
+                rootN=f(n), F0=f(n), y=f(n), yv=f(n), ya=f(n), FW=f(n), dW=f(n), watch=np.zeros(n, np.int64),
+                ev=f((6, 2 * n)))
+
+
+@kernel_jit(forceinline=True)
+def basis(lam, s):
+    """(C0, C1, C2, C3, C4) at s for a mode of eigenvalue ``lam`` (per tau_dyn^2): C0 = cos(w s) and each
+    C_{n+1} the integral from 0 of C_n; Taylor series below lambda s^2 = TAYLOR (a rigid mode: 1, s, s^2 / 2, ...).
+    """
+    x = lam * s * s
+    if abs(x) < TAYLOR:
+        s2 = s * s
+        c0 = 1.0 - x / 2.0 * (1.0 - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (
+            1.0 - x / 132.0)))))
+        c1 = s * (1.0 - x / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0 * (1.0 - x / 110.0 * (
+            1.0 - x / 156.0))))))
+        c2 = s2 / 2.0 * (1.0 - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (
+            1.0 - x / 132.0 * (1.0 - x / 182.0))))))
+        c3 = s2 * s / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0 * (1.0 - x / 110.0 * (
+            1.0 - x / 156.0 * (1.0 - x / 210.0))))))
+        c4 = s2 * s2 / 24.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (
+            1.0 - x / 182.0 * (1.0 - x / 240.0))))))
+        return c0, c1, c2, c3, c4
+    w = math.sqrt(lam)
+    ws = w * s
+    sn = math.sin(ws)
+    half = math.sin(0.5 * ws)
+    c2 = 2.0 * half * half / lam  # (1 - cos) / lambda without cancellation
+    c3 = (s - sn / w) / lam
+    return math.cos(ws), sn / w, c2, c3, (0.5 * s * s - c2) / lam
+
+
+@kernel_jit(forceinline=True)
+def force(net, f_ext, u, j, dtheta):
+    """F_j = f_ext,j - (K u)_j + g_j (theta - theta(0)), in N (``dtheta`` = theta - theta(0), in Ntilde)."""
+    F = f_ext[j] + net.g[j] * dtheta
+    for p in range(net.indptr[j], net.indptr[j + 1]):
+        F -= net.K_data[p] * u[net.indices[p]]
+    return F
+
+
+@kernel_jit()
+def elastic_energy(net, u):
+    """u . K u / 2, in N Ntilde l0."""
+    e = 0.0
+    for i in range(u.size):
+        Ku = 0.0
+        for p in range(net.indptr[i], net.indptr[i + 1]):
+            Ku += net.K_data[p] * u[net.indices[p]]
+        e += u[i] * Ku
+    return 0.5 * e
+
+
+@kernel_jit()
+def jacobi_eigh(A, V, lam, m):
+    """The eigen-decomposition of the symmetric m x m block of A by cyclic Jacobi rotations.
+
+    A is overwritten (diagonalized); on return V[:m, :m] holds the orthonormal eigenvectors in columns and
+    lam[:m] the eigenvalues. Rotations continue until the off-diagonal part is below 1e-32 of the diagonal's
+    (squared norms): eigenvalues and vectors to rounding.
+    """
+    for i in range(m):
+        for k in range(m):
+            V[i, k] = 0.0
+        V[i, i] = 1.0
+    for _sweep in range(100):
+        off = 0.0
+        diag = 0.0
+        for p in range(m):
+            diag += A[p, p] * A[p, p]
+            for q in range(p + 1, m):
+                off += A[p, q] * A[p, q]
+        if off <= 1e-32 * diag or off == 0.0:
+            break
+        for p in range(m - 1):
+            for q in range(p + 1, m):
+                apq = A[p, q]
+                if apq == 0.0:
+                    continue
+                th = (A[q, q] - A[p, p]) / (2.0 * apq)
+                t = 1.0 / (abs(th) + math.sqrt(th * th + 1.0))
+                if th < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                s = t * c
+                for k in range(m):
+                    akp = A[k, p]
+                    akq = A[k, q]
+                    A[k, p] = c * akp - s * akq
+                    A[k, q] = s * akp + c * akq
+                for k in range(m):
+                    apk = A[p, k]
+                    aqk = A[q, k]
+                    A[p, k] = c * apk - s * aqk
+                    A[q, k] = s * apk + c * aqk
+                for k in range(m):
+                    vkp = V[k, p]
+                    vkq = V[k, q]
+                    V[k, p] = c * vkp - s * vkq
+                    V[k, q] = s * vkp + c * vkq
+    for k in range(m):
+        lam[k] = A[k, k]
+
+
+@kernel_jit()
+def modal_state(wk, m, s, integral):
+    """y, y' and y'' of the m moving nodes at s into wk.y, wk.yv, wk.ya (``integral``: wk.y gets the
+    integral of y from 0 to s instead, for the work of the drive)."""
+    for p in range(m):
+        wk.y[p] = 0.0
+        wk.yv[p] = 0.0
+        wk.ya[p] = 0.0
+    for k in range(m):
+        lam = wk.lam[k]
+        c0, c1, c2, c3, c4 = basis(lam, s)
+        if integral:
+            a = wk.ap0[k] * c2 + wk.beta[k] * c3 + wk.gamma[k] * c4
+        else:
+            a = wk.ap0[k] * c1 + wk.beta[k] * c2 + wk.gamma[k] * c3
+        av = wk.ap0[k] * c0 + wk.beta[k] * c1 + wk.gamma[k] * c2
+        aa = -lam * wk.ap0[k] * c1 + wk.beta[k] * c0 + wk.gamma[k] * c1
+        for p in range(m):
+            phi = wk.Q[p, k] / wk.rootN[p]
+            wk.y[p] += phi * a
+            wk.yv[p] += phi * av
+            wk.ya[p] += phi * aa
+
+
+@kernel_jit()
+def event_value(wk, mo, m, e, s):
+    """The event function e at s and its derivative: e < m, sigma v of moving node M[e] (a stop where it
+    falls through 0); e >= m, |F_j| - mu_s,j N_j of watched node j = W[e - m] (a start where it rises
+    through 0)."""
+    modal_state(wk, m, s, False)
+    if e < m:
+        sg = mo.sig[wk.M[e]]
+        return sg * wk.yv[e], sg * wk.ya[e]
+    r = e - m
+    F = wk.FW[r] + wk.dW[r] * s
+    dF = wk.dW[r]
+    for p in range(m):
+        F -= wk.KWM[r, p] * wk.y[p]
+        dF -= wk.KWM[r, p] * wk.yv[p]
+    j = wk.W[r]
+    if F >= 0.0:
+        return F - mo.lim[j], dF
+    return -F - mo.lim[j], -dF
+
+
+@kernel_jit()
+def root(wk, mo, m, e, lo, hi, f_lo):
+    """The root of event function e in [lo, hi], where it changes sign (f(lo) = ``f_lo``): bracketed Newton,
+    bisecting where a step would leave the bracket, to a few ulps of s."""
+    x = hi
+    for _it in range(200):
+        if hi - lo <= 4.0 * 2.220446049250313e-16 * hi:
+            break
+        f, fp = event_value(wk, mo, m, e, x)
+        if f == 0.0:
+            return x
+        if (f > 0.0) == (f_lo > 0.0):
+            lo = x
+            f_lo = f
+        else:
+            hi = x
+        nx = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
+        if not (lo < nx < hi):
+            nx = 0.5 * (lo + hi)
+        x = nx
+    return hi
+
+
+@kernel_jit()
+def crossing(wk, mo, m, e, a, b, fa, dfa, fb, dfb):
+    """The first root of event function e in [a, b] in its direction (stops fall, starts rise), or -1.
+
+    A sign change is bracketed at once. Without one, f'(a) and f'(b) that bracket an extremum toward zero
+    (a minimum of a stop function, a maximum of a start function) are followed to it by bisection on f';
+    if the extremum crosses, the root lies between a and it.
+    """
+    sgn = 1.0 if e < m else -1.0  # the function is on the side sgn f > 0 before its event
+    if sgn * fa > 0.0 and sgn * fb <= 0.0:
+        return root(wk, mo, m, e, a, b, fa)
+    if sgn * fa > 0.0 and sgn * dfa < 0.0 and sgn * dfb > 0.0:
+        lo, hi = a, b
+        for _it in range(200):
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            f, fp = event_value(wk, mo, m, e, mid)
+            if sgn * f <= 0.0:
+                return root(wk, mo, m, e, a, mid, fa)
+            if sgn * fp < 0.0:
+                lo = mid
+            else:
+                hi = mid
+    return -1.0
+
+
+@kernel_jit()
+def lone_stop(wk, mo, s_max):
+    """The stop of a lone moving node (mode 0), in closed form, or inf where it comes after ``s_max``.
+
+    sigma v(s) = P cos(w s) + Q sin(w s) + R with P = sigma (v0 - gamma / lambda) / rootN, Q = sigma beta /
+    (w rootN), R = sigma gamma / (lambda rootN): its first falling root is w s = phi + acos(-R / A), phi =
+    atan2(Q, P), A = hypot(P, Q), taken modulo 2 pi to the first positive one; then two Newton steps.
+    """
+    lam = wk.lam[0]
+    if lam <= 0.0:
+        return -1.0  # no spring: the sampled search
+    w = math.sqrt(lam)
+    sg = mo.sig[wk.M[0]]
+    rn = wk.rootN[0]
+    P = sg * (wk.ap0[0] - wk.gamma[0] / lam) / rn
+    Q = sg * wk.beta[0] / (w * rn)
+    R = sg * wk.gamma[0] / (lam * rn)
+    A = math.hypot(P, Q)
+    if A == 0.0 or R >= A:
+        return math.inf
+    ratio = -R / A
+    if ratio < -1.0:
+        ratio = -1.0
+    x = math.atan2(Q, P) + math.acos(ratio)
+    while x <= 0.0:
+        x += 2.0 * math.pi
+    while x - 2.0 * math.pi > 0.0:
+        x -= 2.0 * math.pi
+    s = x / w
+    if s > s_max:
+        return math.inf
+    for _it in range(2):
+        f, fp = event_value(wk, mo, 1, 0, s)
+        if fp != 0.0:
+            s -= f / fp
+    return s
+
+
+@kernel_jit()
+def event_values(wk, mo, m, nw, s, row):
+    """Every event function and its derivative at s into wk.ev[row] and wk.ev[row + 1] (see event_value)."""
+    modal_state(wk, m, s, False)
+    for e in range(m):
+        sg = mo.sig[wk.M[e]]
+        wk.ev[row, e] = sg * wk.yv[e]
+        wk.ev[row + 1, e] = sg * wk.ya[e]
+    for r in range(nw):
+        F = wk.FW[r] + wk.dW[r] * s
+        dF = wk.dW[r]
+        for p in range(m):
+            F -= wk.KWM[r, p] * wk.y[p]
+            dF -= wk.KWM[r, p] * wk.yv[p]
+        if F >= 0.0:
+            wk.ev[row, m + r] = F - mo.lim[wk.W[r]]
+            wk.ev[row + 1, m + r] = dF
+        else:
+            wk.ev[row, m + r] = -F - mo.lim[wk.W[r]]
+            wk.ev[row + 1, m + r] = -dF
+
+
+@kernel_jit()
+def curvature_bounds(wk, m, nw, s_end):
+    """Bounds on |f''| over [0, s_end] of each event function, into wk.ev[4].
+
+    Mode k: a_k^(3) = (gamma - lambda a'0) cos(w s) - w beta sin(w s) and a_k^(2) = beta cos(w s) + (gamma -
+    lambda a'0) sin(w s) / w, so |a_k^(3)| <= hypot(gamma - lambda a'0, w beta) and |a_k^(2)| <=
+    min(hypot(beta, |gamma - lambda a'0| / w), |beta| + |gamma - lambda a'0| s_end) (|sin(w s) / w| <= s:
+    rigid modes too). A stop's f = sigma_i v_i has f^(2) = sigma_i sum_k phi_ik a_k^(3); a start's
+    F_j^(2) = -sum_k (K_jM phi_k) a_k^(2).
+    """
+    for e in range(m + nw):
+        wk.ev[4, e] = 0.0
+    for k in range(m):
+        lam = wk.lam[k]
+        w = math.sqrt(lam)
+        g3 = wk.gamma[k] - lam * wk.ap0[k]
+        jerk = math.hypot(g3, w * wk.beta[k])
+        acc = abs(wk.beta[k]) + abs(g3) * s_end
+        if w > 0.0:
+            acc = min(acc, math.hypot(wk.beta[k], g3 / w))
+        for p in range(m):
+            wk.ev[4, p] += abs(wk.Q[p, k] / wk.rootN[p]) * jerk
+        for r in range(nw):
+            kphi = 0.0
+            for p in range(m):
+                kphi += wk.KWM[r, p] * wk.Q[p, k] / wk.rootN[p]
+            wk.ev[4, m + r] += abs(kphi) * acc
+
+
+@kernel_jit(forceinline=True)
+def safe_step(f, df, bound):
+    """How far an event function with f > 0 before its event (slope ``df``, |f^(2)| <= ``bound``) surely
+    stays > 0: the positive root of f + df h - bound h^2 / 2, in the form without cancellation (f = 0 rising,
+    a node that starts now: 2 df / bound)."""
+    if f < 0.0 or (f == 0.0 and df <= 0.0):
+        return 0.0
+    disc = math.sqrt(df * df + 2.0 * bound * f)
+    if df < 0.0:
+        return 2.0 * f / (disc - df)
+    if bound > 0.0:
+        return (df + disc) / bound
+    return math.inf
+
+
+@kernel_jit()
+def watch(wk, mo, m, nw, s_end, w_max):
+    """The first event in (0, s_end] among the stops of the moving nodes (unless the lone one's, in closed
+    form) and the starts of the watched stuck nodes (wk.watch): (s, event) or (-1, -1).
+
+    From each sample a the next is a + h: h is the shortest of the steps over which each function surely
+    keeps its side (safe_step, from its value, its slope and a bound on its curvature), but at least
+    SAMPLE / w_max; the functions that the step could carry across zero are checked on [a, a + h] for a
+    sign change and for an extremum that dips through zero (crossing).
+    """
+    h_min = MAX_SAMPLE if w_max <= 0.0 else min(MAX_SAMPLE, SAMPLE / w_max)
+    lone = m == 1 and wk.lam[0] > 0.0  # the lone node's stop is the closed form's
+    curvature_bounds(wk, m, nw, s_end)
+    event_values(wk, mo, m, nw, 0.0, 0)
+    # A watched node at its threshold and rising starts now (as the reference's events do).
+    for r in range(nw):
+        if wk.watch[r] and wk.ev[0, m + r] == 0.0 and wk.ev[1, m + r] > 0.0:
+            return 0.0, m + r
+    a = 0.0
+    while a < s_end:
+        h = math.inf
+        for e in range(m + nw):
+            if (e < m and lone) or (e >= m and wk.watch[e - m] == 0):
+                continue
+            f = wk.ev[0, e]
+            if e < m:
+                he = safe_step(f, wk.ev[1, e], wk.ev[4, e])
+            else:
+                he = safe_step(-f, -abs(wk.ev[1, e]), wk.ev[4, e])
+            wk.ev[5, e] = he
+            h = min(h, he)
+        h = max(h, h_min)
+        b = a + h if h < s_end - a else s_end
+        event_values(wk, mo, m, nw, b, 2)
+        found = -1.0
+        found_e = -1
+        for e in range(m + nw):
+            if (e < m and lone) or (e >= m and wk.watch[e - m] == 0) or wk.ev[5, e] >= b - a:
+                continue
+            if e < m and wk.ev[0, e] == 0.0:
+                continue  # a node starting now: sigma v rises from 0
+            x = crossing(wk, mo, m, e, a, b, wk.ev[0, e], wk.ev[1, e], wk.ev[2, e], wk.ev[3, e])
+            if x >= 0.0 and (found < 0.0 or x < found):
+                found = x
+                found_e = e
+        if found >= 0.0:
+            return found, found_e
+        for e in range(m + nw):
+            wk.ev[0, e] = wk.ev[2, e]
+            wk.ev[1, e] = wk.ev[3, e]
+        a = b
+    return -1.0, -1
+
+
+@kernel_jit()
+def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
+    """One phase of motion from the current state, theta - theta(0) = ``dtheta`` + ``rate`` s (Ntilde; rate
+    per tau_dyn), to the first event or to ``s_max`` tau_dyn.
+
+    Moves the moving nodes (u, v) to the phase's end and returns (s1, what, node, work): what is NO_EVENT,
+    STOP (``node`` stopped; its v is left for the caller to read) or START (a stuck node reached its
+    threshold), and ``work`` the work of f_ext + (theta - theta(0)) g on the motion, in N Ntilde l0.
+    """
+    N = mo.u.size
+    m = 0
+    for i in range(N):
+        if mo.moving[i]:
+            wk.M[m] = i
+            wk.where[i] = m
+            m += 1
+    # The stuck nodes that a moving node touches (watched), their rows K_WM, and K_MM.
+    nw = 0
+    for p in range(m):
+        i = wk.M[p]
+        for q in range(net.indptr[i], net.indptr[i + 1]):
+            j = net.indices[q]
+            if wk.where[j] == N:
+                wk.where[j] = -1 - nw
+                wk.W[nw] = j
+                nw += 1
+    for p in range(m):
+        for q in range(m):
+            wk.Kmm[p, q] = 0.0
+    for r in range(nw):
+        for p in range(m):
+            wk.KWM[r, p] = 0.0
+    for p in range(m):
+        i = wk.M[p]
+        for q in range(net.indptr[i], net.indptr[i + 1]):
+            j = net.indices[q]
+            k = wk.where[j]
+            if k >= 0 and k < N:
+                wk.Kmm[p, k] = net.K_data[q]
+            elif k < 0:
+                wk.KWM[-1 - k, p] = net.K_data[q]  # K is symmetric: K_jM_p = K_M_p j
+    # The modes of N^-1/2 K_MM N^-1/2.
+    for p in range(m):
+        wk.rootN[p] = math.sqrt(net.normal_load[wk.M[p]])
+    for p in range(m):
+        for q in range(m):
+            wk.Kmm[p, q] /= wk.rootN[p] * wk.rootN[q]
+    if m == 1:
+        wk.lam[0] = wk.Kmm[0, 0]
+        wk.Q[0, 0] = 1.0
+    else:
+        jacobi_eigh(wk.Kmm, wk.Q, wk.lam, m)
+    w_max = 0.0
+    for k in range(m):
+        if wk.lam[k] < 0.0:
+            wk.lam[k] = 0.0  # rounding of a rigid mode: K is positive semi-definite
+        w_max = max(w_max, math.sqrt(wk.lam[k]))
+    for p in range(m):
+        i = wk.M[p]
+        wk.F0[p] = force(net, f_ext, mo.u, i, dtheta)
+    for k in range(m):
+        a0 = 0.0
+        be = 0.0
+        ga = 0.0
+        for p in range(m):
+            i = wk.M[p]
+            qpk = wk.Q[p, k]
+            a0 += qpk * wk.rootN[p] * mo.v[i]
+            be += qpk * (wk.F0[p] - mu_d * net.normal_load[i] * mo.sig[i]) / wk.rootN[p]
+            ga += qpk * rate * net.g[i] / wk.rootN[p]
+        wk.ap0[k] = a0
+        wk.beta[k] = be
+        wk.gamma[k] = ga
+    s_end = s_max
+    what = NO_EVENT
+    node = -1
+    # Stuck nodes no moving node touches: a force linear in s, a closed-form start (the reference's
+    # _next_start); ties go to the lowest index, as numpy's argmin.
+    if rate != 0.0:
+        for j in range(N):
+            if wk.where[j] != N or net.g[j] == 0.0:
+                continue
+            d = net.g[j] * rate
+            F = force(net, f_ext, mo.u, j, dtheta)
+            sj = (mo.lim[j] - F) / d if d > 0.0 else (mo.lim[j] + F) / -d
+            sj = max(sj, 0.0)
+            if sj < s_end:
+                s_end = sj
+                what = START
+                node = j
+    # A moving node a hair past its stop (v sigma < 0 after another node's event) stops now.
+    for p in range(m):
+        i = wk.M[p]
+        if mo.v[i] * mo.sig[i] < 0.0:
+            s_end = 0.0
+            what = STOP
+            node = i
+            break
+    if s_end > 0.0 and m == 1:
+        s_stop = lone_stop(wk, mo, s_end)
+        if s_stop >= 0.0 and s_stop < s_end:
+            s_end = s_stop
+            what = STOP
+            node = wk.M[0]
+    # The watched stuck nodes: bound |F_j| over [0, s_end]; sample only those the bound cannot clear.
+    n_watch = 0
+    if s_end > 0.0:
+        for r in range(nw):
+            j = wk.W[r]
+            wk.FW[r] = force(net, f_ext, mo.u, j, dtheta)
+            wk.dW[r] = net.g[j] * rate
+            const = wk.FW[r]
+            slope = wk.dW[r]
+            swing = 0.0
+            rigid = False
+            for k in range(m):
+                kphi = 0.0
+                for p in range(m):
+                    kphi += wk.KWM[r, p] * wk.Q[p, k] / wk.rootN[p]
+                if kphi == 0.0:
+                    continue
+                lam = wk.lam[k]
+                if lam * s_end * s_end < TAYLOR:
+                    rigid = True
+                    break
+                # a_k = (beta + gamma s) / lambda - (beta / lambda) cos + (a'0 - gamma / lambda) sin / w
+                const -= kphi * wk.beta[k] / lam
+                slope -= kphi * wk.gamma[k] / lam
+                swing += abs(kphi) * math.hypot(wk.beta[k] / lam,
+                                                (wk.ap0[k] - wk.gamma[k] / lam) / math.sqrt(lam))
+            bound = max(abs(const), abs(const + slope * s_end)) + swing
+            wk.watch[r] = 1 if (rigid or bound >= mo.lim[j]) else 0
+            n_watch += wk.watch[r]
+    if s_end > 0.0 and (m > 1 or n_watch > 0 or wk.lam[0] <= 0.0):
+        found, found_e = watch(wk, mo, m, nw, s_end, w_max)
+        if found >= 0.0 and found < s_end:
+            s_end = found
+            if found_e < m:
+                what = STOP
+                node = wk.M[found_e]
+            else:
+                what = START
+                node = wk.W[found_e - m]
+    # Move to s_end; the work of the loads: sum_p (f_ext + dtheta g)_p y_p(s1) + r g_p (s1 y_p - int y_p).
+    work = 0.0
+    if s_end > 0.0:
+        modal_state(wk, m, s_end, True)
+        for p in range(m):
+            work -= rate * net.g[wk.M[p]] * wk.y[p]
+        modal_state(wk, m, s_end, False)
+        for p in range(m):
+            i = wk.M[p]
+            work += (f_ext[i] + net.g[i] * (dtheta + rate * s_end)) * wk.y[p]
+            mo.u[i] += wk.y[p]
+            mo.v[i] = wk.yv[p]
+    for p in range(m):
+        wk.where[wk.M[p]] = N
+    for r in range(nw):
+        wk.where[wk.W[r]] = N
+    return s_end, what, node, work
+
+
+@kernel_jit()
+def start_node(mo, istate, fstate, i, F):
+    """Node i starts along F (its force, N): one rearrangement, v = 0."""
+    moving_any = False
+    for j in range(mo.u.size):
+        if mo.moving[j]:
+            moving_any = True
+            break
+    if moving_any:
+        istate[I_OVERLAP] += 1
+    istate[I_N] += 1
+    mo.moving[i] = 1
+    mo.sig[i] = 1.0 if F > 0.0 else -1.0
+    mo.v[i] = 0.0
+    mo.start_t[i] = fstate[F_T]
+    mo.start_clock[i] = fstate[F_CLOCK]
+    mo.start_u[i] = mo.u[i]
+
+
+@kernel_jit()
+def any_moving(mo):
+    for i in range(mo.u.size):
+        if mo.moving[i]:
+            return True
+    return False
+
+
+@kernel_jit()
+def begin_avalanche(net, mo, fstate):
+    """The network leaves rest: the avalanche's start time and elastic energy, its work zeroed."""
+    fstate[F_T0] = fstate[F_T]
+    fstate[F_E0] = elastic_energy(net, mo.u)
+    fstate[F_WORK] = 0.0
+
+
+@kernel_jit()
+def start_overloaded(net, f_ext, mo, istate, fstate, dtheta):
+    """Start every stuck node above its threshold, the largest overload |F|/(mu_s N) first, one at a time."""
+    while True:
+        best = 1.0
+        node = -1
+        Fbest = 0.0
+        for j in range(mo.u.size):
+            if mo.moving[j]:
+                continue
+            F = force(net, f_ext, mo.u, j, dtheta)
+            over = abs(F) / mo.lim[j]
+            if over > best:
+                best = over
+                node = j
+                Fbest = F
+        if node < 0:
+            return
+        if not any_moving(mo):
+            begin_avalanche(net, mo, fstate)
+        start_node(mo, istate, fstate, node, Fbest)
+
+
+@kernel_jit()
+def after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, dtheta, tau_ratio):
+    """Apply the event that ended a phase (t and u already at its time): a stop (the slip logged, a new
+    threshold drawn) or a start; then start whatever is above its threshold; log an avalanche that ended."""
+    if what == STOP:
+        i = node
+        fstate[F_STOP_SPEED] = max(fstate[F_STOP_SPEED], abs(mo.v[i]))
+        mo.moving[i] = 0
+        mo.v[i] = 0.0
+        k = istate[I_SLIPS]
+        log.slip_start[k] = mo.start_t[i]
+        log.slip_end[k] = fstate[F_T]
+        log.slip_duration[k] = (fstate[F_CLOCK] - mo.start_clock[i]) * tau_ratio
+        log.slip_node[k] = i
+        log.slip_du[k] = mo.u[i] - mo.start_u[i]
+        istate[I_SLIPS] = k + 1
+        # A new place on the substrate: a new threshold.
+        mo.mu[i] = draws[istate[I_POS]]
+        istate[I_POS] += 1
+        mo.lim[i] = mo.mu[i] * net.normal_load[i]
+    elif what == START:
+        best = -math.inf
+        j_best = -1
+        F_best = 0.0
+        for j in range(mo.u.size):
+            if mo.moving[j]:
+                continue
+            F = force(net, f_ext, mo.u, j, dtheta)
+            if abs(F) - mo.lim[j] > best:
+                best = abs(F) - mo.lim[j]
+                j_best = j
+                F_best = F
+        start_node(mo, istate, fstate, j_best, F_best)
+    # At rest (if only for an instant, before a restart): the avalanche ends here, kinetic energy zero.
+    if not any_moving(mo):
+        k = istate[I_AVAL]
+        log.av_start[k] = fstate[F_T0]
+        log.av_end[k] = fstate[F_T]
+        log.av_work[k] = fstate[F_WORK]
+        log.av_e0[k] = fstate[F_E0]
+        log.av_e1[k] = elastic_energy(net, mo.u)
+        istate[I_AVAL] = k + 1
+    start_overloaded(net, f_ext, mo, istate, fstate, dtheta)
+
+
+@kernel_jit()
+def runaway(mo, fstate, istate):
+    """A node has moved MAX_SLIP_DURATION tau_dyn without stopping: True, and its index in istate[I_NODE]."""
+    longest = -1.0
+    node = -1
+    for i in range(mo.u.size):
+        if mo.moving[i] and fstate[F_CLOCK] - mo.start_clock[i] > longest:
+            longest = fstate[F_CLOCK] - mo.start_clock[i]
+            node = i
+    if node >= 0 and longest >= MAX_SLIP_DURATION:
+        istate[I_NODE] = node
+        return True
+    return False
+
+
+@kernel_jit()
+def run_inertia(net, f_ext, mu_d, tau_ratio, thetas, rec, steps, mo, wk, log, draws, istate, fstate):
+    """Run one realization of a 1D network with inertia through ``steps`` thermal steps, resumably.
+
+    Mirrors the reference's ``_Realization.run`` and ``_segment``: the initial overload relaxed with theta
+    frozen at theta(0), then per step q the records (if q is recorded) and the motion with theta linear
+    from thetas[q] to thetas[q + 1] (Ntilde). Returns DONE, NEED_MU (the threshold buffer ``draws`` is read
+    to its end: refill it and set istate[I_POS] = 0), NEED_EVENTS (a log is full: grow it) or RUNAWAY
+    (istate[I_NODE] slid MAX_SLIP_DURATION tau_dyn); it checks before each phase, so every return is at a
+    clean point, and calling it again resumes.
+    """
+    theta0 = thetas[0]
+    while True:
+        if istate[I_STAGE] == STAGE_OVERLOAD:
+            # An f_ext above some thresholds is relaxed with theta frozen at theta(0), before the t = 0 record.
+            start_overloaded(net, f_ext, mo, istate, fstate, 0.0)
+            istate[I_STAGE] = STAGE_RELAX
+        elif istate[I_STAGE] == STAGE_RELAX:
+            if not any_moving(mo):
+                istate[I_STAGE] = STAGE_RECORD
+                continue
+            if istate[I_POS] >= draws.size:
+                return NEED_MU
+            if istate[I_SLIPS] >= log.slip_node.size or istate[I_AVAL] >= log.av_end.size:
+                return NEED_EVENTS
+            s1, what, node, work = phase(net, f_ext, mo, wk, mu_d, 0.0, 0.0, MAX_SLIP_DURATION)
+            fstate[F_CLOCK] += s1
+            fstate[F_WORK] += work
+            after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, 0.0, tau_ratio)
+            if runaway(mo, fstate, istate):
+                return RUNAWAY
+        elif istate[I_STAGE] == STAGE_RECORD:
+            q = istate[I_Q]
+            k = istate[I_REC]
+            if k < rec.size and rec[k] == q:
+                log.out_n[k] = istate[I_N]
+                mx = -math.inf
+                xg = 0.0
+                for i in range(mo.u.size):
+                    mx = max(mx, mo.mu[i])
+                    xg += net.w[i] * mo.u[i]
+                log.out_mu_max[k] = mx
+                log.out_xg[k] = xg
+                istate[I_REC] = k + 1
+            if q == steps:
+                return DONE
+            istate[I_STAGE] = STAGE_STEP
+        else:
+            q = istate[I_Q]
+            theta_a = thetas[q]
+            rate = thetas[q + 1] - theta_a  # per tau_th
+            t = fstate[F_T]
+            theta = theta_a + rate * (t - q)
+            if any_moving(mo):
+                if istate[I_POS] >= draws.size:
+                    return NEED_MU
+                if istate[I_SLIPS] >= log.slip_node.size or istate[I_AVAL] >= log.av_end.size:
+                    return NEED_EVENTS
+                left = (q + 1 - t) / tau_ratio
+                s1, what, node, work = phase(net, f_ext, mo, wk, mu_d, theta - theta0, rate * tau_ratio,
+                                             min(left, MAX_SLIP_DURATION))
+                fstate[F_CLOCK] += s1
+                fstate[F_WORK] += work
+                if what == NO_EVENT and s1 >= left:
+                    fstate[F_T] = float(q + 1)
+                    istate[I_Q] = q + 1
+                    istate[I_STAGE] = STAGE_RECORD
+                    continue
+                fstate[F_T] = t + tau_ratio * s1
+                theta = theta_a + rate * (fstate[F_T] - q)
+                after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, theta - theta0, tau_ratio)
+                if runaway(mo, fstate, istate):
+                    return RUNAWAY
+            else:
+                # Nothing moves: F_j = F_j(t) + g_j rate x, the first start in closed form (eq. `critique`).
+                wait = math.inf
+                j_best = -1
+                for j in range(mo.u.size):
+                    d = net.g[j] * rate
+                    if d == 0.0:
+                        continue
+                    F = force(net, f_ext, mo.u, j, theta - theta0)
+                    x = (mo.lim[j] - F) / d if d > 0.0 else (mo.lim[j] + F) / -d
+                    x = max(x, 0.0)
+                    if x < wait:
+                        wait = x
+                        j_best = j
+                # Inclusive at the end of the step, as the solver's eq. `critique`.
+                if j_best < 0 or t + wait > q + 1:
+                    fstate[F_T] = float(q + 1)
+                    istate[I_Q] = q + 1
+                    istate[I_STAGE] = STAGE_RECORD
+                    continue
+                fstate[F_T] = t + wait
+                theta = theta_a + rate * (fstate[F_T] - q)
+                begin_avalanche(net, mo, fstate)
+                start_node(mo, istate, fstate, j_best, force(net, f_ext, mo.u, j_best, theta - theta0))
+                start_overloaded(net, f_ext, mo, istate, fstate, theta - theta0)
