@@ -140,7 +140,8 @@ class Log(NamedTuple):
     row per slip that came to rest (``slip_start``, ``slip_end`` in tau_th, ``slip_duration`` in tau_th,
     ``slip_node``, ``slip_du`` in Ntilde l0); one row per avalanche from rest to rest (``av_start``,
     ``av_end`` in tau_th, ``av_work`` the work of the loads f_ext + (theta - theta(0)) g on the motion,
-    ``av_e0`` and ``av_e1`` the elastic energy u.K u / 2 before and after, in N Ntilde l0)."""
+    ``av_e0`` and ``av_e1`` the elastic energy u.K u / 2 before and after, in N Ntilde l0, ``av_slips`` the
+    slips logged by its end: its own are those from the previous avalanche's)."""
 
     out_n: np.ndarray
     out_mu_max: np.ndarray
@@ -155,6 +156,7 @@ class Log(NamedTuple):
     av_work: np.ndarray
     av_e0: np.ndarray
     av_e1: np.ndarray
+    av_slips: np.ndarray
 
 
 def new_work(n: int) -> Work:
@@ -780,6 +782,7 @@ def after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, dtheta, 
         log.av_work[k] = fstate[F_WORK]
         log.av_e0[k] = fstate[F_E0]
         log.av_e1[k] = elastic_energy(net, mo.u)
+        log.av_slips[k] = istate[I_SLIPS]
         istate[I_AVAL] = k + 1
     start_overloaded(net, f_ext, mo, istate, fstate, dtheta)
 

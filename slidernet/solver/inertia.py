@@ -104,9 +104,11 @@ class InertialSolver:
             from rest to rest, each of shape (A,): ``start`` and ``end``
             (tau_th), ``work`` (the work of the loads f_ext + (theta -
             theta(0)) g on the motion), ``e0`` and ``e1`` (the elastic
-            energy u.K u / 2 before and after), in N l0. Each avalanche's
-            energy balance reads work = e1 - e0 + sum over its slips of
-            mu_d N_i |du_i| (the kinetic energy is zero at both ends).
+            energy u.K u / 2 before and after), in N l0; ``slips`` (int64),
+            the slips logged by its end (its own: from the previous
+            avalanche's ``slips`` on). Each avalanche's energy balance reads
+            work = e1 - e0 + sum over its slips of mu_d N_i |du_i| (the
+            kinetic energy is zero at both ends).
 
         Raises
         ------
@@ -172,6 +174,7 @@ class InertialSolver:
                 "work": log.av_work[:A] * Ntilde,
                 "e0": log.av_e0[:A] * Ntilde,
                 "e1": log.av_e1[:A] * Ntilde,
+                "slips": log.av_slips[:A].copy(),
             },
         }
 
@@ -181,7 +184,7 @@ def _new_log(records: int, rows: int) -> kin.Log:
     return kin.Log(out_n=f(records, np.int64), out_mu_max=f(records), out_xg=f(records),
                    slip_start=f(rows), slip_end=f(rows), slip_duration=f(rows), slip_node=f(rows, np.int64),
                    slip_du=f(rows), av_start=f(rows), av_end=f(rows), av_work=f(rows), av_e0=f(rows),
-                   av_e1=f(rows))
+                   av_e1=f(rows), av_slips=f(rows, np.int64))
 
 
 def _grow_log(log: kin.Log) -> kin.Log:
