@@ -34,17 +34,22 @@ the integral of C_n from 0, which is how the work of the drive is integrated.
 **Events** end a phase: a moving node's velocity returns to zero (the root
 of sigma_i v_i(s), falling), a stuck node's |F_j(s)| reaches mu_s,j N_j
 (rising), or the end of the driver step. A lone moving node (one mode) has
-its stop in closed form: sigma v(s) = P cos(w s) + Q sin(w s) + R. A stuck
-node that no moving node touches sees a force linear in s (closed form).
-The other stuck nodes are first bounded over the phase (each modal
-amplitude is at most |P_k| + |R_k| s + hypot(U_k, V_k)); only those that the
-bound cannot clear, and the stops of a moving segment of several nodes,
-are watched by sampling at ``SAMPLE`` / w_max tau_dyn (well below the
-shortest period 2 pi / w_max), where each interval is checked for a sign
-change and, from the derivatives at its ends, for an extremum that dips
-through zero inside it; the root is then polished by a bracketed Newton
-iteration to a few ulps. Stuck nodes never move; only their thresholds are
-watched.
+its stop in closed form: sigma v(s) = P cos(w s) + Q sin(w s) + R; a stuck
+neighbour of a lone node that no drive pushes sees F_j = c + A cos(w s - phi),
+whose start is in closed form too. A stuck node that no moving node touches
+sees a force linear in s (closed form). The other stuck nodes are first
+bounded over the phase (each modal amplitude is at most |P_k| + |R_k| s +
+hypot(U_k, V_k)); only those that the bound cannot clear, and the stops of a
+moving segment of several nodes, are watched (:func:`watch`): from each
+sample the next is as far as every watched function surely keeps its sign,
+from its value, its slope and a bound on its curvature (:func:`safe_step`),
+but at least ``SAMPLE`` / w_max tau_dyn (well below the shortest period
+2 pi / w_max); a function that the step could carry across zero is checked
+on the interval for a sign change and, from its slopes at the ends, for an
+extremum that dips through zero inside it (:func:`crossing`); the root is
+then polished by a bracketed Newton iteration to a few ulps of s. Stuck
+nodes never move; only their thresholds are watched. The modes of a moving
+set are computed once and cached under its bit mask (:func:`modes`).
 
 **The traps.** A node starts along F_j (sigma_j = sign F_j) with v = 0; at
 s = 0 of the next phase its stop function is 0 and rising, so the search
@@ -81,6 +86,8 @@ MAX_SAMPLE = 0.2
 # first term left out is below 1e-16 of the sum).
 TAYLOR = 0.25
 
+EPS = 2.220446049250313e-16  # float64's machine epsilon
+
 # Integer scalars (istate) and float scalars (fstate) of a realization.
 I_STAGE, I_Q, I_REC, I_N, I_OVERLAP, I_SLIPS, I_POS, I_NODE, I_AVAL, I_AV_START = range(10)
 F_T, F_CLOCK, F_STOP_SPEED, F_WORK, F_E0, F_T0 = range(6)
@@ -109,10 +116,13 @@ class Motion(NamedTuple):
 class Work(NamedTuple):
     """Scratch of one phase, sized for N nodes: ``M`` the moving nodes, ``W`` the watched stuck ones
     (``where`` maps a node to its place in M, -1 - its place in W, or N when in neither); ``Kmm`` (N, N)
-    K_MM then its rotations, ``Q`` (N, N) the modes, ``KWM`` (N, N) the rows K_WM; per mode ``lam``,
+    K_MM then its rotations, ``Q`` (N, N) the modes, ``KWM`` (N, N) the rows K_WM and ``kphi`` (N, N)
+    their products K_WM phi_k with the modes; per mode ``lam``,
     ``ap0``, ``beta``, ``gamma``; per moving node ``rootN`` = sqrt(N_i), ``F0``, ``y``, ``yv``, ``ya``;
     per watched node ``FW``, ``dW`` (its drive) and ``watch`` (1: sampled); ``ev`` (6, 2 N) the event
-    functions of the search (values and slopes at two samples, curvature bounds, safe steps)."""
+    functions of the search (values and slopes at two samples, curvature bounds, safe steps); the cache of
+    the modes of recurring moving sets (:func:`modes`): ``cache_key`` (C,) bit masks (0: empty),
+    ``cache_Q`` (C, N, N), ``cache_lam`` (C, N)."""
 
     M: np.ndarray
     W: np.ndarray
@@ -120,6 +130,7 @@ class Work(NamedTuple):
     Kmm: np.ndarray
     Q: np.ndarray
     KWM: np.ndarray
+    kphi: np.ndarray
     lam: np.ndarray
     ap0: np.ndarray
     beta: np.ndarray
@@ -133,6 +144,9 @@ class Work(NamedTuple):
     dW: np.ndarray
     watch: np.ndarray
     ev: np.ndarray
+    cache_key: np.ndarray
+    cache_Q: np.ndarray
+    cache_lam: np.ndarray
 
 
 class Log(NamedTuple):
@@ -160,12 +174,18 @@ class Log(NamedTuple):
 
 
 def new_work(n: int) -> Work:
-    """Scratch for a network of ``n`` nodes."""
+    """Scratch for a network of ``n`` nodes, with a cache of modes of at most 16 MiB (none above 62 nodes)."""
     f = np.zeros
+    C = 0
+    if n <= 62:
+        C = 1024
+        while C > 16 and C * n * n * 8 > 1 << 24:
+            C //= 2
     return Work(M=np.zeros(n, np.int64), W=np.zeros(n, np.int64), where=np.full(n, n, np.int64),
-                Kmm=f((n, n)), Q=f((n, n)), KWM=f((n, n)), lam=f(n), ap0=f(n), beta=f(n), gamma=f(n),
+                Kmm=f((n, n)), Q=f((n, n)), KWM=f((n, n)), kphi=f((n, n)), lam=f(n), ap0=f(n), beta=f(n),
+                gamma=f(n),
                 rootN=f(n), F0=f(n), y=f(n), yv=f(n), ya=f(n), FW=f(n), dW=f(n), watch=np.zeros(n, np.int64),
-                ev=f((6, 2 * n)))
+                ev=f((6, 2 * n)), cache_key=np.zeros(C, np.int64), cache_Q=f((C, n, n)), cache_lam=f((C, n)))
 
 
 @kernel_jit(forceinline=True)
@@ -269,6 +289,43 @@ def jacobi_eigh(A, V, lam, m):
 
 
 @kernel_jit()
+def modes(wk, m):
+    """The modes (wk.Q, wk.lam) of the m x m matrix in wk.Kmm, through the cache of the moving sets.
+
+    A moving set recurs (the ends of a chain, the same segment): its modes are kept under the bit mask of
+    M (networks of at most 62 nodes) in a table of ``cache_key.size`` entries (open addressing, 4 probes,
+    a miss overwrites the first probe). A hit copies what Jacobi computed from the same K_MM: the same
+    numbers to the bit, so the cache changes no result.
+    """
+    C = wk.cache_key.size
+    slot = -1
+    if C > 0:
+        key = 0
+        for p in range(m):
+            key |= 1 << wk.M[p]
+        h = (key * -7046029254386353131) >> 17  # Fibonacci hashing, 2^64 / golden ratio
+        for probe in range(4):
+            c = (h + probe) & (C - 1)
+            if wk.cache_key[c] == key:
+                for p in range(m):
+                    wk.lam[p] = wk.cache_lam[c, p]
+                    for k in range(m):
+                        wk.Q[p, k] = wk.cache_Q[c, p, k]
+                return
+            if wk.cache_key[c] == 0 and slot < 0:
+                slot = c
+        if slot < 0:
+            slot = h & (C - 1)
+        wk.cache_key[slot] = key
+    jacobi_eigh(wk.Kmm, wk.Q, wk.lam, m)
+    if slot >= 0:
+        for p in range(m):
+            wk.cache_lam[slot, p] = wk.lam[p]
+            for k in range(m):
+                wk.cache_Q[slot, p, k] = wk.Q[p, k]
+
+
+@kernel_jit()
 def modal_state(wk, m, s, integral):
     """y, y' and y'' of the m moving nodes at s into wk.y, wk.yv, wk.ya (``integral``: wk.y gets the
     integral of y from 0 to s instead, for the work of the drive)."""
@@ -296,17 +353,26 @@ def modal_state(wk, m, s, integral):
 def event_value(wk, mo, m, e, s):
     """The event function e at s and its derivative: e < m, sigma v of moving node M[e] (a stop where it
     falls through 0); e >= m, |F_j| - mu_s,j N_j of watched node j = W[e - m] (a start where it rises
-    through 0)."""
-    modal_state(wk, m, s, False)
+    through 0). One pass over the modes: F_j = F_j(0) + d_j s - sum_k (K_jM phi_k) a_k (wk.kphi)."""
+    r = e - m
+    x0 = 0.0
+    x1 = 0.0
+    for k in range(m):
+        lam = wk.lam[k]
+        c0, c1, c2, c3, _ = basis(lam, s)
+        if e < m:
+            phi = wk.Q[e, k] / wk.rootN[e]
+            x0 += phi * (wk.ap0[k] * c0 + wk.beta[k] * c1 + wk.gamma[k] * c2)
+            x1 += phi * (-lam * wk.ap0[k] * c1 + wk.beta[k] * c0 + wk.gamma[k] * c1)
+        else:
+            kphi = wk.kphi[r, k]
+            x0 += kphi * (wk.ap0[k] * c1 + wk.beta[k] * c2 + wk.gamma[k] * c3)
+            x1 += kphi * (wk.ap0[k] * c0 + wk.beta[k] * c1 + wk.gamma[k] * c2)
     if e < m:
         sg = mo.sig[wk.M[e]]
-        return sg * wk.yv[e], sg * wk.ya[e]
-    r = e - m
-    F = wk.FW[r] + wk.dW[r] * s
-    dF = wk.dW[r]
-    for p in range(m):
-        F -= wk.KWM[r, p] * wk.y[p]
-        dF -= wk.KWM[r, p] * wk.yv[p]
+        return sg * x0, sg * x1
+    F = wk.FW[r] + wk.dW[r] * s - x0
+    dF = wk.dW[r] - x1
     j = wk.W[r]
     if F >= 0.0:
         return F - mo.lim[j], dF
@@ -319,7 +385,7 @@ def root(wk, mo, m, e, lo, hi, f_lo):
     bisecting where a step would leave the bracket, to a few ulps of s."""
     x = hi
     for _it in range(200):
-        if hi - lo <= 4.0 * 2.220446049250313e-16 * hi:
+        if hi - lo <= 4.0 * EPS * hi:
             break
         f, fp = event_value(wk, mo, m, e, x)
         if f == 0.0:
@@ -332,6 +398,8 @@ def root(wk, mo, m, e, lo, hi, f_lo):
         nx = x - f / fp if fp != 0.0 else 0.5 * (lo + hi)
         if not (lo < nx < hi):
             nx = 0.5 * (lo + hi)
+        elif abs(nx - x) <= 2.0 * EPS * x:
+            return nx  # Newton has converged to an ulp or two, from one side
         x = nx
     return hi
 
@@ -342,12 +410,21 @@ def crossing(wk, mo, m, e, a, b, fa, dfa, fb, dfb):
 
     A sign change is bracketed at once. Without one, f'(a) and f'(b) that bracket an extremum toward zero
     (a minimum of a stop function, a maximum of a start function) are followed to it by bisection on f';
-    if the extremum crosses, the root lies between a and it.
+    if the extremum crosses, the root lies between a and it. Before that, the extremum is bounded from the
+    two ends with the curvature bound B = wk.ev[4, e]: g = sgn f >= g(a) + g'(a) t - B t^2 / 2 and >=
+    g(b) - g'(b) (L - t) - B (L - t)^2 / 2 (t = s - a, L = b - a); where the two bounds meet above zero,
+    g never reaches it.
     """
     sgn = 1.0 if e < m else -1.0  # the function is on the side sgn f > 0 before its event
     if sgn * fa > 0.0 and sgn * fb <= 0.0:
         return root(wk, mo, m, e, a, b, fa)
     if sgn * fa > 0.0 and sgn * dfa < 0.0 and sgn * dfb > 0.0:
+        ga, da, gb, db = sgn * fa, sgn * dfa, sgn * fb, sgn * dfb
+        L = b - a
+        B = wk.ev[4, e]
+        t = min(max((ga - gb + db * L + 0.5 * B * L * L) / (db - da + B * L), 0.0), L)
+        if ga + da * t - 0.5 * B * t * t > 0.0:
+            return -1.0
         lo, hi = a, b
         for _it in range(200):
             mid = 0.5 * (lo + hi)
@@ -369,7 +446,7 @@ def lone_stop(wk, mo, s_max):
 
     sigma v(s) = P cos(w s) + Q sin(w s) + R with P = sigma (v0 - gamma / lambda) / rootN, Q = sigma beta /
     (w rootN), R = sigma gamma / (lambda rootN): its first falling root is w s = phi + acos(-R / A), phi =
-    atan2(Q, P), A = hypot(P, Q), taken modulo 2 pi to the first positive one; then two Newton steps.
+    atan2(Q, P), A = hypot(P, Q), taken modulo 2 pi to the first positive one; then a Newton step.
     """
     lam = wk.lam[0]
     if lam <= 0.0:
@@ -394,10 +471,9 @@ def lone_stop(wk, mo, s_max):
     s = x / w
     if s > s_max:
         return math.inf
-    for _it in range(2):
-        f, fp = event_value(wk, mo, 1, 0, s)
-        if fp != 0.0:
-            s -= f / fp
+    f, fp = event_value(wk, mo, 1, 0, s)
+    if fp != 0.0:
+        s -= f / fp
     return s
 
 
@@ -446,10 +522,7 @@ def curvature_bounds(wk, m, nw, s_end):
         for p in range(m):
             wk.ev[4, p] += abs(wk.Q[p, k] / wk.rootN[p]) * jerk
         for r in range(nw):
-            kphi = 0.0
-            for p in range(m):
-                kphi += wk.KWM[r, p] * wk.Q[p, k] / wk.rootN[p]
-            wk.ev[4, m + r] += abs(kphi) * acc
+            wk.ev[4, m + r] += abs(wk.kphi[r, k]) * acc
 
 
 @kernel_jit(forceinline=True)
@@ -522,6 +595,44 @@ def watch(wk, mo, m, nw, s_end, w_max):
 
 
 @kernel_jit()
+def lone_start(wk, mo, r, const):
+    """When watched node W[r] reaches its threshold while a lone node moves with no drive (closed form), or inf.
+
+    F_j(s) = const + Pc cos(w s) + Qs sin(w s) = const + A cos(w s - phi), Pc = kphi beta / lambda,
+    Qs = -kphi (a'0 - gamma / lambda) / w: it rises through +lim at w s = phi - acos((lim - const) / A) and
+    falls through -lim at phi + acos((-lim - const) / A), modulo 2 pi; the earlier, then a Newton step.
+    """
+    lam = wk.lam[0]
+    w = math.sqrt(lam)
+    kphi = wk.kphi[r, 0]
+    Pc = kphi * wk.beta[0] / lam
+    Qs = -kphi * (wk.ap0[0] - wk.gamma[0] / lam) / w
+    A = math.hypot(Pc, Qs)
+    if A == 0.0:
+        return math.inf
+    phi = math.atan2(Qs, Pc)
+    lim = mo.lim[wk.W[r]]
+    two_pi = 2.0 * math.pi
+    x = math.inf
+    c = (lim - const) / A
+    if c <= 1.0:
+        xp = phi - math.acos(max(c, -1.0))
+        x = min(x, xp - two_pi * math.floor(xp / two_pi))
+    c = (-lim - const) / A
+    if c >= -1.0:
+        xm = phi + math.acos(min(c, 1.0))
+        x = min(x, xm - two_pi * math.floor(xm / two_pi))
+    if x == math.inf:
+        return x
+    s = x / w
+    if s > 0.0:
+        f, fp = event_value(wk, mo, 1, 1 + r, s)
+        if fp != 0.0 and abs(f / fp) < 1e-6 * s:
+            s -= f / fp
+    return s
+
+
+@kernel_jit()
 def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
     """One phase of motion from the current state, theta - theta(0) = ``dtheta`` + ``rate`` s (Ntilde; rate
     per tau_dyn), to the first event or to ``s_max`` tau_dyn.
@@ -572,7 +683,7 @@ def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
         wk.lam[0] = wk.Kmm[0, 0]
         wk.Q[0, 0] = 1.0
     else:
-        jacobi_eigh(wk.Kmm, wk.Q, wk.lam, m)
+        modes(wk, m)
     w_max = 0.0
     for k in range(m):
         if wk.lam[k] < 0.0:
@@ -640,12 +751,13 @@ def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
                 kphi = 0.0
                 for p in range(m):
                     kphi += wk.KWM[r, p] * wk.Q[p, k] / wk.rootN[p]
+                wk.kphi[r, k] = kphi
                 if kphi == 0.0:
                     continue
                 lam = wk.lam[k]
                 if lam * s_end * s_end < TAYLOR:
                     rigid = True
-                    break
+                    continue
                 # a_k = (beta + gamma s) / lambda - (beta / lambda) cos + (a'0 - gamma / lambda) sin / w
                 const -= kphi * wk.beta[k] / lam
                 slope -= kphi * wk.gamma[k] / lam
@@ -653,6 +765,14 @@ def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
                                                 (wk.ap0[k] - wk.gamma[k] / lam) / math.sqrt(lam))
             bound = max(abs(const), abs(const + slope * s_end)) + swing
             wk.watch[r] = 1 if (rigid or bound >= mo.lim[j]) else 0
+            if wk.watch[r] and m == 1 and slope == 0.0 and not rigid:
+                # A lone slider that no drive pushes: F_j = const + A cos(w s - phi), a closed-form start.
+                wk.watch[r] = 0
+                s_j = lone_start(wk, mo, r, const)
+                if s_j < s_end:
+                    s_end = s_j
+                    what = START
+                    node = j
             n_watch += wk.watch[r]
     if s_end > 0.0 and (m > 1 or n_watch > 0 or wk.lam[0] <= 0.0):
         found, found_e = watch(wk, mo, m, nw, s_end, w_max)
