@@ -118,7 +118,7 @@ class Work(NamedTuple):
     (``where`` maps a node to its place in M, -1 - its place in W, or N when in neither); ``Kmm`` (N, N)
     K_MM then its rotations, ``Q`` (N, N) the modes, ``KWM`` (N, N) the rows K_WM and ``kphi`` (N, N)
     their products K_WM phi_k with the modes; per mode ``lam``,
-    ``ap0``, ``beta``, ``gamma``; per moving node ``rootN`` = sqrt(N_i), ``F0``, ``y``, ``yv``, ``ya``;
+    ``ap0``, ``beta``, ``gamma``; per moving node ``rootN`` = sqrt(N_i), ``F0``, ``y``, ``yv``, ``ya``, ``yint``;
     per watched node ``FW``, ``dW`` (its drive) and ``watch`` (1: sampled); ``ev`` (6, 2 N) the event
     functions of the search (values and slopes at two samples, curvature bounds, safe steps); the cache of
     the modes of recurring moving sets (:func:`modes`): ``cache_key`` (C,) bit masks (0: empty),
@@ -140,6 +140,7 @@ class Work(NamedTuple):
     y: np.ndarray
     yv: np.ndarray
     ya: np.ndarray
+    yint: np.ndarray
     FW: np.ndarray
     dW: np.ndarray
     watch: np.ndarray
@@ -183,8 +184,8 @@ def new_work(n: int) -> Work:
             C //= 2
     return Work(M=np.zeros(n, np.int64), W=np.zeros(n, np.int64), where=np.full(n, n, np.int64),
                 Kmm=f((n, n)), Q=f((n, n)), KWM=f((n, n)), kphi=f((n, n)), lam=f(n), ap0=f(n), beta=f(n),
-                gamma=f(n),
-                rootN=f(n), F0=f(n), y=f(n), yv=f(n), ya=f(n), FW=f(n), dW=f(n), watch=np.zeros(n, np.int64),
+                gamma=f(n), rootN=f(n), F0=f(n), y=f(n), yv=f(n), ya=f(n), yint=f(n), FW=f(n), dW=f(n),
+                watch=np.zeros(n, np.int64),
                 ev=f((6, 2 * n)), cache_key=np.zeros(C, np.int64), cache_Q=f((C, n, n)), cache_lam=f((C, n)))
 
 
@@ -210,10 +211,14 @@ def basis(lam, s):
     w = math.sqrt(lam)
     ws = w * s
     sn = math.sin(ws)
-    half = math.sin(0.5 * ws)
-    c2 = 2.0 * half * half / lam  # (1 - cos) / lambda without cancellation
+    cs = math.cos(ws)
+    if cs < 0.5:
+        c2 = (1.0 - cs) / lam  # 1 - cos >= 1/2: no cancellation
+    else:
+        half = math.sin(0.5 * ws)
+        c2 = 2.0 * half * half / lam  # (1 - cos) / lambda without cancellation
     c3 = (s - sn / w) / lam
-    return math.cos(ws), sn / w, c2, c3, (0.5 * s * s - c2) / lam
+    return cs, sn / w, c2, c3, (0.5 * s * s - c2) / lam
 
 
 @kernel_jit(forceinline=True)
@@ -327,26 +332,27 @@ def modes(wk, m):
 
 @kernel_jit()
 def modal_state(wk, m, s, integral):
-    """y, y' and y'' of the m moving nodes at s into wk.y, wk.yv, wk.ya (``integral``: wk.y gets the
-    integral of y from 0 to s instead, for the work of the drive)."""
+    """y, y' and y'' of the m moving nodes at s into wk.y, wk.yv, wk.ya (with ``integral``, also the integral
+    of y from 0 to s into wk.yint, for the work of the drive)."""
     for p in range(m):
         wk.y[p] = 0.0
         wk.yv[p] = 0.0
         wk.ya[p] = 0.0
+        wk.yint[p] = 0.0
     for k in range(m):
         lam = wk.lam[k]
         c0, c1, c2, c3, c4 = basis(lam, s)
-        if integral:
-            a = wk.ap0[k] * c2 + wk.beta[k] * c3 + wk.gamma[k] * c4
-        else:
-            a = wk.ap0[k] * c1 + wk.beta[k] * c2 + wk.gamma[k] * c3
+        a = wk.ap0[k] * c1 + wk.beta[k] * c2 + wk.gamma[k] * c3
         av = wk.ap0[k] * c0 + wk.beta[k] * c1 + wk.gamma[k] * c2
         aa = -lam * wk.ap0[k] * c1 + wk.beta[k] * c0 + wk.gamma[k] * c1
+        ai = wk.ap0[k] * c2 + wk.beta[k] * c3 + wk.gamma[k] * c4
         for p in range(m):
             phi = wk.Q[p, k] / wk.rootN[p]
             wk.y[p] += phi * a
             wk.yv[p] += phi * av
             wk.ya[p] += phi * aa
+            if integral:
+                wk.yint[p] += phi * ai
 
 
 @kernel_jit()
@@ -789,9 +795,7 @@ def phase(net, f_ext, mo, wk, mu_d, dtheta, rate, s_max):
     if s_end > 0.0:
         modal_state(wk, m, s_end, True)
         for p in range(m):
-            work -= rate * net.g[wk.M[p]] * wk.y[p]
-        modal_state(wk, m, s_end, False)
-        for p in range(m):
+            work -= rate * net.g[wk.M[p]] * wk.yint[p]
             i = wk.M[p]
             work += (f_ext[i] + net.g[i] * (dtheta + rate * s_end)) * wk.y[p]
             mo.u[i] += wk.y[p]
