@@ -247,6 +247,23 @@ def elastic_energy(net, u):
     return 0.5 * e
 
 
+@kernel_jit(forceinline=True)
+def rotate(X, p, q, c, s, m, columns):
+    """Rotate columns p and q of X[:m, :m] (``columns``) or its rows p and q by the angle of (c, s):
+    x_p, x_q -> c x_p - s x_q, s x_p + c x_q."""
+    for k in range(m):
+        if columns:
+            xp = X[k, p]
+            xq = X[k, q]
+            X[k, p] = c * xp - s * xq
+            X[k, q] = s * xp + c * xq
+        else:
+            xp = X[p, k]
+            xq = X[q, k]
+            X[p, k] = c * xp - s * xq
+            X[q, k] = s * xp + c * xq
+
+
 @kernel_jit()
 def jacobi_eigh(A, V, lam, m):
     """The eigen-decomposition of the symmetric m x m block of A by cyclic Jacobi rotations.
@@ -279,21 +296,9 @@ def jacobi_eigh(A, V, lam, m):
                     t = -t
                 c = 1.0 / math.sqrt(t * t + 1.0)
                 s = t * c
-                for k in range(m):
-                    akp = A[k, p]
-                    akq = A[k, q]
-                    A[k, p] = c * akp - s * akq
-                    A[k, q] = s * akp + c * akq
-                for k in range(m):
-                    apk = A[p, k]
-                    aqk = A[q, k]
-                    A[p, k] = c * apk - s * aqk
-                    A[q, k] = s * apk + c * aqk
-                for k in range(m):
-                    vkp = V[k, p]
-                    vkq = V[k, q]
-                    V[k, p] = c * vkp - s * vkq
-                    V[k, q] = s * vkp + c * vkq
+                rotate(A, p, q, c, s, m, True)
+                rotate(A, p, q, c, s, m, False)
+                rotate(V, p, q, c, s, m, True)
     for k in range(m):
         lam[k] = A[k, k]
 
@@ -852,22 +857,30 @@ def begin_avalanche(net, mo, fstate):
 
 
 @kernel_jit(forceinline=True)
+def most_loaded(net, f_ext, mo, dtheta, ratio):
+    """The stuck node with the largest |F_j| / (mu_s,j N_j) (``ratio``) or |F_j| - mu_s,j N_j, the lowest
+    index of a tie (numpy's argmax, as the reference): (node, F_node, that value); (-1, 0, -inf) if none."""
+    best = -math.inf
+    node = -1
+    F_node = 0.0
+    for j in range(mo.u.size):
+        if mo.moving[j]:
+            continue
+        F = force(net, f_ext, mo.u, j, dtheta)
+        value = abs(F) / mo.lim[j] if ratio else abs(F) - mo.lim[j]
+        if value > best:
+            best = value
+            node = j
+            F_node = F
+    return node, F_node, best
+
+
+@kernel_jit(forceinline=True)
 def start_overloaded(net, f_ext, mo, istate, fstate, dtheta):
     """Start every stuck node above its threshold, the largest overload |F|/(mu_s N) first, one at a time."""
     while True:
-        best = 1.0
-        node = -1
-        Fbest = 0.0
-        for j in range(mo.u.size):
-            if mo.moving[j]:
-                continue
-            F = force(net, f_ext, mo.u, j, dtheta)
-            over = abs(F) / mo.lim[j]
-            if over > best:
-                best = over
-                node = j
-                Fbest = F
-        if node < 0:
+        node, Fbest, best = most_loaded(net, f_ext, mo, dtheta, True)
+        if best <= 1.0:
             return
         if not any_moving(mo):
             begin_avalanche(net, mo, fstate)
@@ -895,17 +908,7 @@ def after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, dtheta, 
         istate[I_POS] += 1
         mo.lim[i] = mo.mu[i] * net.normal_load[i]
     elif what == START:
-        best = -math.inf
-        j_best = -1
-        F_best = 0.0
-        for j in range(mo.u.size):
-            if mo.moving[j]:
-                continue
-            F = force(net, f_ext, mo.u, j, dtheta)
-            if abs(F) - mo.lim[j] > best:
-                best = abs(F) - mo.lim[j]
-                j_best = j
-                F_best = F
+        j_best, F_best, _ = most_loaded(net, f_ext, mo, dtheta, False)
         start_node(mo, istate, fstate, j_best, F_best)
     # At rest (if only for an instant, before a restart): the avalanche ends here, kinetic energy zero.
     if not any_moving(mo):
