@@ -11,10 +11,12 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from slidernet.config import load_config
 from slidernet.errors import AvalancheError, ConfigError
-from slidernet.model.network import chain
+from slidernet.model.network import Network, chain
 from slidernet.solver import Realization, Scene, simulate
 from slidernet.solver.inertia import InertialSolver
 from slidernet.validation.dynamics import Dynamics
@@ -250,3 +252,50 @@ def test_2d_refused() -> None:
 def test_bad_steps() -> None:
     with pytest.raises(ConfigError, match=r"'steps' parameter of InertialSolver\.run must be an integer in \[0"):
         InertialSolver(scene(1), 1e-3).run(np.random.SeedSequence(0), steps=2)
+
+
+# -- any 1D network, and the invariants of every scene ---------------------------------------------------------
+
+
+def ring_with_chords(n: int, **overrides: Any):
+    """A 1D network that is no chain: a ring of n sliders with two chords, so that a moving segment's K_MM is
+    full (not tridiagonal) and the nodes have 2 to 4 springs."""
+    edges = [[i, (i + 1) % n] for i in range(n)] + [[0, n // 2], [1, n // 2 + 2]]
+    return Network(positions=np.arange(n, dtype=float), edges=np.array(edges), Ntilde=Ntilde, **overrides)
+
+
+SIGMA_RING = 1e-7
+
+
+def test_any_1d_network_slip_for_slip_as_the_reference() -> None:
+    """A ring of 6 with chords, unequal masses: the same slips as the reference, as on the chain."""
+    net = ring_with_chords(6, normal_load=[1.0, 1.5, 0.8, 1.2, 1.0, 2.0])
+    sc = scene(1, {"kind": "chain", "n": 6, "Ntilde": Ntilde}, SIGMA_RING, net=net)
+    out = InertialSolver(sc, 1e-3).run(np.random.SeedSequence(2))
+    ref = Dynamics(sc, 1e-3).run(np.random.SeedSequence(2))
+    slips, expected = out["slips"], ref["slips"]
+    assert 20 <= expected["node"].size <= 150 and out["overlapping"] >= 5
+    np.testing.assert_array_equal(slips["node"], expected["node"])
+    assert np.abs(slips["du"] - expected["du"]).max() <= 1e-8 * np.abs(expected["du"]).min()
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(n=st.integers(2, 7), ring=st.booleans(), tau_exp=st.floats(-6.0, -1.0), seed=st.integers(0, 2**32 - 1),
+       loads=st.lists(st.floats(0.5, 2.0), min_size=7, max_size=7), k=st.floats(0.5, 2.0))
+def test_invariants_of_any_1d_scene(n: int, ring: bool, tau_exp: float, seed: int, loads: list[float],
+                                    k: float) -> None:
+    """For any small 1D network, tau_ratio and seed: one start per rearrangement (the slips that came to rest
+    plus the nodes still moving), every slip moves its node along one sign by more than nothing, and every
+    avalanche balances its energy to 1e-9 (Ntilde = 1e-7, sigma_theta / Ntilde = 3, 3 steps)."""
+    overrides = {"normal_load": loads[:n], "k": k}
+    net = ring_with_chords(n, **overrides) if ring and n >= 5 else chain(n, Ntilde=Ntilde, **overrides)
+    sc = scene(3, {"kind": "chain", "n": n, "Ntilde": Ntilde}, 3e-7, net=net)
+    out = InertialSolver(sc, 10.0 ** tau_exp).run(np.random.SeedSequence(seed))
+    slips, av = out["slips"], out["avalanches"]
+    assert out["n"][-1] == slips["node"].size + out["moving_at_end"]
+    assert (slips["du"] != 0.0).all() and (slips["end"] >= slips["start"]).all()
+    heat = MU_D * sc.network.normal_load[slips["node"]] * np.abs(slips["du"])
+    first = np.concatenate([[0], av["slips"]])[:-1].astype(np.int64)
+    dissipated = np.array([heat[a:b].sum() for a, b in zip(first, av["slips"], strict=True)])
+    residual = av["work"] - (av["e1"] - av["e0"]) - dissipated
+    assert (np.abs(residual) <= 1e-9 * np.maximum(dissipated, np.abs(av["work"]))).all()
