@@ -8,7 +8,8 @@ same theta(t_q) and the same stream of mu_s draws as
 reference's outputs, so that the two compare slip for slip. The model, its
 units and its rules are the reference's module docstring's; how the motion
 is solved (modes of the moving segment, closed-form lone slips, a
-safeguarded event search) is :mod:`slidernet.kernels.inertia`'s.
+safeguarded event search) is :mod:`slidernet.kernels.inertia`'s and
+:mod:`slidernet.kernels.inertia_phase`'s.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 
 from slidernet.errors import AvalancheError, ConfigError, param_error
 from slidernet.kernels import inertia as kin
+from slidernet.kernels.inertia_phase import new_work
 from slidernet.kernels.state import DONE, NEED_EVENTS, NEED_MU
 from slidernet.solver.scene import Scene
 from slidernet.solver.streams import horizontal_draws, realization_streams
@@ -132,7 +134,7 @@ class InertialSolver:
         fstate = np.zeros(6)
         draws = np.empty(0)
         f_ext = np.ascontiguousarray(net.f_ext, dtype=np.float64).reshape(-1)
-        work = kin.new_work(N)
+        work = new_work(N)
         while True:
             code = kin.run_inertia(scene.operators, f_ext, float(scene.mu_d), self.tau_ratio, thetas, rec,
                                    int(steps), mo, work, log, draws, istate, fstate)
