@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import math
 import sys
 import time
@@ -205,6 +206,42 @@ def tables(data: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def calibrated(results: dict[str, Any], data: dict[str, Any]) -> str:
+    """``tilt_break_ratio``'s slopes in the aging study's systems (``examples/aging_networks.py``'s JSON,
+    ``results``), each at ratio 0.3 beside its gain, the recovery of the uniform rise at e = 1 in this study's
+    JSON (``data``), and the slope divided by it: a rate of the thresholds (1e-4 per decade of t). The
+    quotient's error combines both relative errors (delta method; the two runs are independent)."""
+    gain = {}
+    for p in data["points"]:
+        if p["select"] == 1.0 and p["overshoot"] == 1.0:
+            r = p["recovery"]["tilt_break_ratio|10-1e3|contact"]
+            gain[(p["kind"], p["N"])] = (r["recovery"], r["sem"])
+    lines = ["| network | N | parameters | slope, t ≥ 10 | slope, t ≥ 100 | slope, ≥ 100 slips per node "
+             "| gain (uniform rise, e = 1, ratio 0.3) | t ≥ 10 slope / gain |",
+             "|---|---|---|---|---|---|---|---|"]
+    for p in results["points"]:
+        w = p["windows"].get("tilt_break_ratio")
+        if p["mu_eff_at"] != "records" or not w or p["rule"] != "e = 1" or p["condition"]:
+            continue
+
+        def slope(label: str, w: dict[str, Any] = w) -> str:
+            if label not in w:
+                return "–"
+            s = w[label]["slope_per_decade"]
+            return f"{1e4 * s['mean']:+.1f} ± {1e4 * s['sem']:.1f}"
+
+        g = gain.get((p["kind"], p["N"])) if p["params"] == "ratio0.3" else None
+        quotient = "–"
+        if g is not None:
+            s = w["t>=10"]["slope_per_decade"]
+            q = s["mean"] / g[0]
+            sem = math.hypot(s["sem"] / g[0], q * g[1] / g[0])
+            quotient = f"{1e4 * q:+.1f} ± {1e4 * sem:.1f}"
+        lines.append(f"| {study._label(p)} | {p['N']} | {p['params']} | {slope('t>=10')} | {slope('t>=100')} | "
+                     f"{slope('s>=100')} | {'–' if g is None else f'{g[0]:.2f} ± {g[1]:.2f}'} | {quotient} |")
+    return "\n".join(lines) + "\n"
+
+
 def plot(data: dict[str, Any], path: Path) -> Path:
     """Recovery against N: one panel per estimator and injection, one line per slip rule and kind."""
     fig = Figure(figsize=(24, 6.5), layout="constrained")
@@ -246,7 +283,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="a Dask scheduler address, e.g. tcp://host:8786: realizations run on that cluster")
     parser.add_argument("--resume", action="store_true",
                         help="continue the sweeps of an interrupted run in --out (points already done are kept)")
+    parser.add_argument("--calibrate", type=Path, default=None, metavar="STUDY_JSON",
+                        help="print tilt_break_ratio's slopes in the aging study's JSON (aging_networks.json) "
+                             "divided by their gains in --out's aging_recovery.json, and exit")
     args = parser.parse_args(argv)
+    if args.calibrate is not None:
+        print(calibrated(json.loads(args.calibrate.read_text(encoding="utf-8")),
+                         json.loads((args.out / JSON_NAME).read_text(encoding="utf-8"))), end="")
+        return 0
 
     name = "quick" if args.quick else "full"
     preset = PRESETS[name]
