@@ -70,7 +70,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import slidernet
-from slidernet.analysis.trend import injection_recovery, log_trend
+from slidernet.analysis.trend import grouped_mean_sem, injection_recovery, log_trend
 from slidernet.config import InjectConfig
 from slidernet.io import atomic_output, save_figure, write_json
 
@@ -172,7 +172,8 @@ def recover(ds: xr.Dataset, geometry: np.ndarray, inject: InjectConfig, N: int) 
                 out[f"{name}|{window}|{norm}"] = {
                     "recovery": rec.recovery, "sem": rec.recovery_sem, "dof": rec.dof, "pairs": rec.pairs,
                     "response_per_decade": LN10 * rec.response, "response_sem_per_decade": LN10 * rec.response_sem,
-                    "plain_slope_per_decade": LN10 * float(np.nanmean(slopes[0]))}
+                    "plain_slope_per_decade": LN10 * float(np.nanmean(slopes[0])),
+                    "plain_slope_sem_per_decade": LN10 * grouped_mean_sem(slopes[0], geometry)[1]}
     return out
 
 
@@ -239,6 +240,17 @@ def calibrated(results: dict[str, Any], data: dict[str, Any]) -> str:
             quotient = f"{1e4 * q:+.1f} ± {1e4 * sem:.1f}"
         lines.append(f"| {study._label(p)} | {p['N']} | {p['params']} | {slope('t>=10')} | {slope('t>=100')} | "
                      f"{slope('s>=100')} | {'–' if g is None else f'{g[0]:.2f} ± {g[1]:.2f}'} | {quotient} |")
+    # The pair's plain slopes over the largest ensemble of this study (its plain variables are those of a run
+    # without injection): the reference rate, with the error of its 2 048 realizations.
+    pairs = [p for p in data["points"] if p["kind"] == "pair" and p["overshoot"] == 1.0]
+    big = max(pairs, key=lambda p: p["realizations"], default=None)
+    if big is not None:
+        for name in ("tilt_break_ratio", "mu_eff"):
+            for window, t_min in WINDOWS.items():
+                r = big["recovery"][f"{name}|{window}|contact"]
+                lines.append(f"\nThe pair's plain {name} over {big['realizations']} realizations (e = 1, "
+                             f"ratio 0.3, {t_min:g} <= t <= 1e3): {1e4 * r['plain_slope_per_decade']:+.1f} ± "
+                             f"{1e4 * r['plain_slope_sem_per_decade']:.1f} (1e-4 per decade)")
     return "\n".join(lines) + "\n"
 
 
