@@ -230,7 +230,7 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
         out[k, WORK] = th * (net.g[i, 0] * vx + net.g[i, 1] * vy)
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def dp_step(net, run, mo, wk, m, theta0, r, s, h):
     """One Dormand-Prince step of size h from (s, wk.Y), with wk.Ks[0] = f(s, Y): the result in wk.Yt, its
     derivative in wk.Ks[6], and the error norm returned (<= 1: within the tolerance)."""
@@ -261,7 +261,7 @@ def dp_step(net, run, mo, wk, m, theta0, r, s, h):
     return err
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def watched_excess(net, mo, wk, nw, r, s, Y):
     """max over W of |F_j(s)| - mu_s,j N_j, and the node that reaches it (-1 if W is empty)."""
     Kt = net.K_table
@@ -322,7 +322,7 @@ def locate(net, run, mo, wk, m, nw, theta0, r, s, kind, k, lo, flo, hi, fhi):
     return hi
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _speed_slope(Y, D, k):
     """d|v_k|/ds from the state Y and its derivative D (0 at v_k = 0)."""
     sp = _norm(Y[k, VX], Y[k, VY])
@@ -519,7 +519,7 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
     return s, event, node, nw
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _hold(net, run, mo, wk, m, th0, r, s, h, held):
     """Make wk.Yt the step of size h from s (it holds the step of size ``held``); returns h."""
     if held != h:
@@ -527,7 +527,7 @@ def _hold(net, run, mo, wk, m, th0, r, s, h, held):
     return h
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _copy(src, dst, m):
     for k in range(m):
         for c in range(N_COMP):
