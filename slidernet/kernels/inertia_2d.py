@@ -63,11 +63,14 @@ E = (1/2) u.K u - u.f_ext changes by the exact quadratic form of each phase's
 displacements. Per avalanche, work = dE + sum_i mu_d N_i path_i + the kinetic
 energy (1/2) N_i |v_i|^2 <= (1/2) N_i SS^2 dropped at each stop.
 
-**Cost.** The steps, not the operators: Dormand-Prince at rtol = 1e-10
-takes 100 to 200 steps per slip (a smooth half-oscillation needs ~100; the
-friction's direction turns ever faster as |v_i| -> 0 at a stop and from
-v_i = 0 at a start, where the steps shrink in proportion to the time to the
-stop or from the start). benchmarks/inertia_2d_speed.py measures it.
+**Cost.** 180 to 200 steps per slip at rtol = 1e-10, ~0.35 us each
+(benchmarks/inertia_2d_speed.py): ~60 % in the half-oscillation at h ~
+0.013 tau_dyn, the rest near the ends of a slip, where the steps grow in
+proportion to the time since the start and shrink with the time to the stop
+(the friction's part across v_i is stiff, rate mu_d / |v_i|). DOP853 takes
+half the steps with twice the stages (scipy's, measured). The helpers called
+at each step are inlined: a call passing the net, run, motion and work
+tuples flattens their ~40 arrays into hundreds of arguments.
 """
 
 from __future__ import annotations
@@ -185,8 +188,7 @@ def node_crit(net, mo, j):
 
 @kernel_jit(forceinline=True)
 def _norm(x, y):
-    """|(x, y)|, without hypot's guard against overflow (libm's hypot costs ~20 ns a call, a fifth of a
-    step; speeds and forces here are within many decades of 1)."""
+    """|(x, y)|: no need of libm's hypot and its guard against overflow (~20 ns a call, a sixth of a step)."""
     return math.sqrt(x * x + y * y)
 
 
