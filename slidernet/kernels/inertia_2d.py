@@ -63,11 +63,14 @@ E = (1/2) u.K u - u.f_ext changes by the exact quadratic form of each phase's
 displacements. Per avalanche, work = dE + sum_i mu_d N_i path_i + the kinetic
 energy (1/2) N_i |v_i|^2 <= (1/2) N_i SS^2 dropped at each stop.
 
-**Cost.** The steps, not the operators: Dormand-Prince at rtol = 1e-10
-takes 100 to 200 steps per slip (a smooth half-oscillation needs ~100; the
-friction's direction turns ever faster as |v_i| -> 0 at a stop and from
-v_i = 0 at a start, where the steps shrink in proportion to the time to the
-stop or from the start). benchmarks/inertia_2d_speed.py measures it.
+**Cost.** 180 to 200 steps per slip at rtol = 1e-10, ~0.35 us each
+(benchmarks/inertia_2d_speed.py): ~60 % in the half-oscillation at h ~
+0.013 tau_dyn, the rest near the ends of a slip, where the steps grow in
+proportion to the time since the start and shrink with the time to the stop
+(the friction's part across v_i is stiff, rate mu_d / |v_i|). DOP853 takes
+half the steps with twice the stages (scipy's, measured). The helpers called
+at each step are inlined: a call passing the net, run, motion and work
+tuples flattens their ~40 arrays into hundreds of arguments.
 """
 
 from __future__ import annotations
@@ -184,6 +187,12 @@ def node_crit(net, mo, j):
 
 
 @kernel_jit(forceinline=True)
+def _norm(x, y):
+    """|(x, y)|: no need of libm's hypot and its guard against overflow (~20 ns a call, a sixth of a step)."""
+    return math.sqrt(x * x + y * y)
+
+
+@kernel_jit(forceinline=True)
 def pushed(Kt, ptr, col, blk, row, Y, fx, fy):
     """(fx, fy) less sum_p K_table[blk[p]] du_col[p] over the entries p of a gathered row (K_MM or K_WM): the
     force on a node from the displacements Y[:, DUX:DUY + 1] of the moving nodes since the phase's start."""
@@ -195,7 +204,7 @@ def pushed(Kt, ptr, col, blk, row, Y, fx, fy):
     return fx, fy
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
     """out = dY/ds of the moving nodes (Y: (m, 6) local state), theta = theta0 + r s."""
     mu_d = run.mu_d
@@ -207,7 +216,7 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
                         wk.F0[k, 1] + net.g[i, 1] * (r * s))
         vx = Y[k, VX]
         vy = Y[k, VY]
-        sp = math.hypot(vx, vy)
+        sp = _norm(vx, vy)
         if sp > 0.0:
             dx = vx / sp
             dy = vy / sp
@@ -223,7 +232,7 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
         out[k, WORK] = th * (net.g[i, 0] * vx + net.g[i, 1] * vy)
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def dp_step(net, run, mo, wk, m, theta0, r, s, h):
     """One Dormand-Prince step of size h from (s, wk.Y), with wk.Ks[0] = f(s, Y): the result in wk.Yt, its
     derivative in wk.Ks[6], and the error norm returned (<= 1: within the tolerance)."""
@@ -254,7 +263,7 @@ def dp_step(net, run, mo, wk, m, theta0, r, s, h):
     return err
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def watched_excess(net, mo, wk, nw, r, s, Y):
     """max over W of |F_j(s)| - mu_s,j N_j, and the node that reaches it (-1 if W is empty)."""
     Kt = net.K_table
@@ -264,7 +273,7 @@ def watched_excess(net, mo, wk, nw, r, s, Y):
         j = wk.W[w]
         fx, fy = pushed(Kt, wk.wptr, wk.wcol, wk.wblk, w, Y, wk.FW[w, 0] + net.g[j, 0] * (r * s),
                         wk.FW[w, 1] + net.g[j, 1] * (r * s))
-        e = math.hypot(fx, fy) - mo.lim[j]
+        e = _norm(fx, fy) - mo.lim[j]
         if e > best:
             best = e
             arg = j
@@ -277,7 +286,7 @@ def _event_value(net, mo, wk, nw, kind, k, r, s):
     kind EV_STOP: STOP_SPEED - |v_k|; EV_START: the watched excess; 3: d|v_k|/ds (a speed's minimum)."""
     Yt = wk.Yt
     if kind == EV_STOP:
-        return STOP_SPEED - math.hypot(Yt[k, VX], Yt[k, VY])
+        return STOP_SPEED - _norm(Yt[k, VX], Yt[k, VY])
     if kind == EV_START:
         e, _ = watched_excess(net, mo, wk, nw, r, s, Yt)
         return e
@@ -315,10 +324,10 @@ def locate(net, run, mo, wk, m, nw, theta0, r, s, kind, k, lo, flo, hi, fhi):
     return hi
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _speed_slope(Y, D, k):
     """d|v_k|/ds from the state Y and its derivative D (0 at v_k = 0)."""
-    sp = math.hypot(Y[k, VX], Y[k, VY])
+    sp = _norm(Y[k, VX], Y[k, VY])
     return (Y[k, VX] * D[k, VX] + Y[k, VY] * D[k, VY]) / sp if sp > 0.0 else 0.0
 
 
@@ -448,8 +457,8 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
             if mo.armed[i] == 0:
                 continue
             held = _hold(net, run, mo, wk, m, th0, r, s, h, held)
-            f_old = STOP_SPEED - math.hypot(Y[k, VX], Y[k, VY])
-            f_new = STOP_SPEED - math.hypot(wk.Yt[k, VX], wk.Yt[k, VY])
+            f_old = STOP_SPEED - _norm(Y[k, VX], Y[k, VY])
+            f_new = STOP_SPEED - _norm(wk.Yt[k, VX], wk.Yt[k, VY])
             hi = -1.0
             if f_new >= 0.0:
                 hi = h
@@ -457,7 +466,7 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
                 # The speed has a minimum inside the step: is it below STOP_SPEED?
                 held = locate(net, run, mo, wk, m, nw, th0, r, s, 3, k, 0.0, _speed_slope(Y, wk.Ks[0], k), h,
                               _speed_slope(wk.Yt, wk.Ks[6], k))
-                f_min = STOP_SPEED - math.hypot(wk.Yt[k, VX], wk.Yt[k, VY])
+                f_min = STOP_SPEED - _norm(wk.Yt[k, VX], wk.Yt[k, VY])
                 if f_min >= 0.0:
                     hi = held
                     f_new = f_min
@@ -498,7 +507,7 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
         ints[STEPS] += 1
         for k in range(m):
             i = wk.M[k]
-            if mo.armed[i] == 0 and math.hypot(Y[k, VX], Y[k, VY]) >= STOP_SPEED:
+            if mo.armed[i] == 0 and _norm(Y[k, VX], Y[k, VY]) >= STOP_SPEED:
                 mo.armed[i] = 1
         if not last:
             factor = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** -0.2))
@@ -512,7 +521,7 @@ def phase(net, run, mo, wk, floats, ints, theta0, theta_ref, r, s_max):
     return s, event, node, nw
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _hold(net, run, mo, wk, m, th0, r, s, h, held):
     """Make wk.Yt the step of size h from s (it holds the step of size ``held``); returns h."""
     if held != h:
@@ -520,7 +529,7 @@ def _hold(net, run, mo, wk, m, th0, r, s, h, held):
     return h
 
 
-@kernel_jit()
+@kernel_jit(forceinline=True)
 def _copy(src, dst, m):
     for k in range(m):
         for c in range(N_COMP):
