@@ -108,7 +108,7 @@ class InertialSolver:
             energy u.K u / 2 before and after), in N l0; ``slips`` (int64),
             the slips logged by its end (its own: from the previous
             avalanche's ``slips`` on). Each avalanche's energy balance reads
-            work = e1 - e0 + sum over its slips of mu_d N_i |du_i| (the
+            work = e1 - e0 + sum over its slips of mu_d N_i ``|du_i|`` (the
             kinetic energy is zero at both ends).
 
         Raises

@@ -73,7 +73,7 @@ class Inertia2D:
         per tau_dyn).
     max_step : float
         Largest step, tau_dyn, > 0: an event that comes and goes within one
-        step (a stuck neighbour's |F_j| above its threshold and below again)
+        step (a stuck neighbour's ``|F_j|`` above its threshold and below again)
         is not seen.
 
     Examples
@@ -119,7 +119,7 @@ class Inertia2D:
             ``x_G``, ``overlapping``, ``moving_at_end``, ``stop_speed`` and
             ``slips`` (``start``, ``end``, ``duration``, ``node``, ``du`` of
             shape (S, 2)), the slips also with ``path`` (l0: the length of
-            the node's path, int |v| dt). Besides: ``avalanches``, a dict of
+            the node's path, ``int |v| dt``). Besides: ``avalanches``, a dict of
             arrays of shape (A,), one per avalanche ended by t = ``steps``
             (from a start with nothing moving to the next moment nothing
             moves): ``start``, ``end`` (tau_th), ``starts`` (int64),
