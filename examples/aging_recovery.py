@@ -167,13 +167,14 @@ def recover(ds: xr.Dataset, geometry: np.ndarray, inject: InjectConfig, N: int) 
         out["rate_per_decade"][window] = LN10 * rate
         for name, (plain, injected) in ESTIMATORS.items():
             slopes = [log_trend(ds[v], t_min=t_min)["slope"].values for v in (plain, injected)]
+            # The plain slope's mean and error by one rule, two-level over geometries like the recovery's.
+            plain_mean, plain_sem, _ = grouped_mean_sem(slopes[0], geometry)
             for norm, r in (("contact", rate), ("mean", share * rate)):
                 rec = injection_recovery(*slopes, r, geometry)
                 out[f"{name}|{window}|{norm}"] = {
                     "recovery": rec.recovery, "sem": rec.recovery_sem, "dof": rec.dof, "pairs": rec.pairs,
                     "response_per_decade": LN10 * rec.response, "response_sem_per_decade": LN10 * rec.response_sem,
-                    "plain_slope_per_decade": LN10 * float(np.nanmean(slopes[0])),
-                    "plain_slope_sem_per_decade": LN10 * grouped_mean_sem(slopes[0], geometry)[1]}
+                    "plain_slope_per_decade": LN10 * plain_mean, "plain_slope_sem_per_decade": LN10 * plain_sem}
     return out
 
 
@@ -300,8 +301,16 @@ def main(argv: Sequence[str] | None = None) -> int:
                              "divided by their gains in --out's aging_recovery.json, and exit")
     args = parser.parse_args(argv)
     if args.calibrate is not None:
-        print(calibrated(json.loads(args.calibrate.read_text(encoding="utf-8")),
-                         json.loads((args.out / JSON_NAME).read_text(encoding="utf-8"))), end="")
+        try:
+            results, data = (json.loads(path.read_text(encoding="utf-8")) for path in (args.calibrate,
+                                                                                      args.out / JSON_NAME))
+            table = calibrated(results, data)
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            # A wrong path or another file than the two studies' JSON: one line, the user's fault.
+            print(f"aging_recovery: error: --calibrate needs examples/aging_networks.py's JSON and this study's "
+                  f"{JSON_NAME} in --out: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return 2
+        print(table, end="")
         return 0
 
     name = "quick" if args.quick else "full"

@@ -163,6 +163,21 @@ def test_aging_recovery_quick(tmp_path):
         assert r["recovery"] == pytest.approx(1.0, abs=1e-9) and r["sem"] < 1e-9
 
 
+@pytest.mark.parametrize("case", ["missing-study", "not-json", "no-recovery-json", "other-json"])
+def test_aging_recovery_calibrate_refuses_wrong_files_in_one_line(tmp_path, capsys, case):
+    study = load_example("aging_recovery")
+    out, given = tmp_path / "out", tmp_path / "study.json"
+    out.mkdir()
+    if case != "no-recovery-json":
+        (out / study.JSON_NAME).write_text(json.dumps({"points": []}), encoding="utf-8")
+    if case == "not-json":
+        given.write_text("not json", encoding="utf-8")
+    elif case in ("no-recovery-json", "other-json"):
+        given.write_text(json.dumps({"points": [{"kind": "pair"}]}), encoding="utf-8")
+    assert study.main(["--out", str(out), "--calibrate", str(given)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("aging_recovery: error: --calibrate needs") and err.count("\n") == 1
+
 def test_aging_networks_quick(tmp_path):
     """The --quick preset (pair, chains 4 and 8, irregular 16 over 2 geometries, triangular 4 x 4, the overshoot,
     a stricter sliding rule, K = 2 tests, a run to 1e4, sigma_theta / Ntilde = 10; 4 realizations to 1e3 tau_th;
