@@ -290,7 +290,8 @@ class Config(_Strict):
         dim = pair.dim if pair is not None else KIND_DIMS[self.network.kind]
         if dim is None:
             return None, False  # a graph file that cannot be read: building the scene reports it
-        two = pair is not None and pair.is_two_slider()
+        # With [dynamics] a pair runs on the inertial kernel, which records what the network kernels do.
+        two = pair is not None and pair.is_two_slider() and self.dynamics is None
         return dim, choose_kernel(self.solver.kernel, two, dim, self.needs_node_state()) == "pair"
 
     def needs_catalogue(self) -> bool:
