@@ -17,7 +17,7 @@ From the bottom up (each module imports only those above it in this list):
 - :mod:`~slidernet.config.network`, :mod:`~slidernet.config.units`,
   :mod:`~slidernet.config.solver`, :mod:`~slidernet.config.execution`,
   :mod:`~slidernet.config.creep`, :mod:`~slidernet.config.tilt`,
-  :mod:`~slidernet.config.shs`: one table each;
+  :mod:`~slidernet.config.shs`, :mod:`~slidernet.config.dynamics`: one table each;
 - :mod:`~slidernet.config.run`: :class:`Config`, the whole run, and the
   names of the observables;
 - :mod:`~slidernet.config.loading`: :func:`load_config`, :func:`read_toml`,
@@ -43,6 +43,7 @@ from __future__ import annotations
 
 from slidernet.config.base import FiniteFloat, PositiveFloat
 from slidernet.config.creep import CreepConfig
+from slidernet.config.dynamics import DynamicsConfig
 from slidernet.config.execution import SCHEDULER_REQUIREMENT, ExecutionConfig, is_scheduler_address
 from slidernet.config.loading import build_network, load_config, read_toml
 from slidernet.config.loading import tomllib as tomllib  # the TOML reader the tests share
@@ -62,7 +63,7 @@ from slidernet.config.tilt import InjectConfig, TiltConfig
 from slidernet.config.units import UnitsConfig
 
 __all__ = ["NETWORK_OBSERVABLES", "OBSERVABLES", "PAIR_TILT_ONLY", "SCHEDULER_REQUIREMENT", "Config",
-           "CreepConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig", "NetworkConfig",
+           "CreepConfig", "DynamicsConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig", "NetworkConfig",
            "Observable", "PluginSpec", "PositiveFloat", "ShsConfig", "SolverConfig", "StrengtheningConfig",
            "TiltConfig", "UnitsConfig", "build_distribution", "build_network",
            "choose_kernel", "choose_tilt_at", "is_finite", "is_scheduler_address", "load_config", "read_toml"]
