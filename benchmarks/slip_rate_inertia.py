@@ -70,7 +70,8 @@ def main(argv: list[str] | None = None) -> int:
     G, R = args.geometries, args.realizations
     groups = np.repeat(np.arange(G), R)
     print(f"irregular {args.n}, {G} geometries x {R} realizations, {args.steps} tau_th; errors over geometries")
-    print("| ratio | τ_dyn/τ_th | slips per τ_th | ⟨abs du⟩ (Ñ l0) | distance per τ_th | rate / QS | distance / QS |")
+    print("| ratio | τ_dyn/τ_th | slips per τ_th | ⟨abs du⟩ (Ñ l0) | distance per τ_th | rate / QS "
+          "| distance / QS |")
     print("|---|---|---|---|---|---|---|")
     for ratio in args.ratios:
         qs = None
