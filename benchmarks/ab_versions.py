@@ -17,9 +17,9 @@ is what makes the comparison fair on a machine whose speed drifts: both
 versions see the same minutes. It prints the load average at the start and
 the end, each benchmark line of each round, then for each line the median
 rate of A and of B, their ratio B/A and the range of the ratios of the
-rounds (each round's B over the same round's A). A line of ``bench_vs_c.py``
-with slidernet's rate and the C yardstick's (run in the same round beside
-each version) also gets the median and range of slidernet / C for A and B.
+rounds (each round's B over the same round's A). A row of ``bench_vs_c.py``
+with a ratio slidernet / C (the C yardstick runs beside each version, in the
+same round) also gets that ratio's median and range for A and for B.
 """
 
 from __future__ import annotations
@@ -86,6 +86,17 @@ def _rates(text: str) -> dict[str, list[float]]:
     return found
 
 
+def _c_ratios(text: str) -> dict[str, float]:
+    """slidernet / C of each row of bench_vs_c.py's table that has one (its fourth column, computed from the
+    unrounded rates), keyed by the row's workload."""
+    found = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.split("|")]
+        if line.startswith("|") and len(cells) > 4 and re.fullmatch(r"[0-9.]+", cells[4]):
+            found[cells[1]] = float(cells[4])
+    return found
+
+
 def _range(values: list[float]) -> str:
     return f"{min(values):.3f}-{max(values):.3f}"
 
@@ -108,6 +119,7 @@ def main(argv: list[str] | None = None) -> int:
             runs.append(("bench_vs_c.py", args.vs_c))
         # (script, label, version) -> the rates of that line, one list per round
         results: dict[tuple[str, str, str], list[list[float]]] = {}
+        c_ratios: dict[tuple[str, str], list[float]] = {}  # (label, version) -> slidernet / C, one per round
         for name, root in versions.items():  # compile each version's kernels into its own cache, untimed
             for script, a in runs:
                 warm = f"{a} --quick" if script == "bench_vs_c.py" else a
@@ -120,6 +132,8 @@ def main(argv: list[str] | None = None) -> int:
                     print(f"--- round {rnd + 1}, {name}, {script}\n{out}", flush=True)
                     for label, rates in _rates(out).items():
                         results.setdefault((script, label, name), []).append(rates)
+                    for label, ratio in _c_ratios(out).items():
+                        c_ratios.setdefault((label, name), []).append(ratio)
         print(f"\nMedian rates over {args.rounds} rounds (M/s), A = {args.base}, B = working tree: "
               "A -> B (B/A; range of the rounds' B/A)")
         for (script, label, name), a_runs in sorted(results.items()):
@@ -132,10 +146,10 @@ def main(argv: list[str] | None = None) -> int:
                 paired = [v / u for u, v in zip(col_a, col_b, strict=True)]
                 cells.append(f"{x:.3g} -> {y:.3g} ({y / x:.3f}; {_range(paired)})")
             print(f"{script:22s} {label[:40]:40s} {'  '.join(cells)}")
-            if script == "bench_vs_c.py" and len(a_runs[0]) == 2:
-                ratios = {v: [r[0] / r[1] for r in runs_] for v, runs_ in (("A", a_runs), ("B", b_runs))}
-                print(f"{'':22s} {'slidernet / C':40s} " + "  ".join(
-                    f"{v} {statistics.median(r):.2f} ({_range(r)})" for v, r in ratios.items()))
+            if script == "bench_vs_c.py" and (label, "A") in c_ratios and (label, "B") in c_ratios:
+                print(f"{'':22s} {'slidernet / C, median (range)':40s} " + "  ".join(
+                    f"{v} {statistics.median(r):.2f} ({min(r):.2f}-{max(r):.2f})"
+                    for v in "AB" for r in [c_ratios[(label, v)]]))
     print(f"load average at the end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0
 
