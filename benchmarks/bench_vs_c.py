@@ -3,6 +3,7 @@
     python benchmarks/bench_vs_c.py [--anchors DIR] [--quick] [--repeat 3] [--sizes L ...] [--core 1]
                                     [--csv PATH] [--no-delaunay] [--paper]
                                     [--rows {pair,workers,lattices,irregular} ...]
+                                    [--irregular-nodes N ...]
 
 The yardsticks are plain C programs that solve the same model the
 straightforward way, on one core: ``twoslider_loop.c`` (the paper's two
@@ -56,7 +57,8 @@ The rows (rates in millions of rearrangements, i.e. slips, per second):
    ``network FILE 1e-7 1e-7 steps 1`` on the same network: the child writes
    slidernet's own network (positions, springs) to FILE in network.c's text
    format before it runs (``--no-irregular-c`` leaves these rows out;
-   network.c is optional in ``--anchors``);
+   network.c is optional in ``--anchors``; ``--irregular-nodes 1000000``
+   runs the largest alone);
 9. the irregular rate at 1e6 nodes over the rate at 1e4, slidernet's and
    network.c's;
 10. with ``--paper``: ``slidernet paper`` (full preset, all cores), wall time
@@ -499,6 +501,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="leave out the irregular (Delaunay) network as large as the largest lattice")
     ap.add_argument("--no-irregular-c", action="store_true",
                     help="leave out rows 8 and 9, the irregular networks against network.c (minutes at 1e6 nodes)")
+    ap.add_argument("--irregular-nodes", type=int, nargs="+", choices=[n for n, _ in IRREGULAR], default=None,
+                    help="run rows 8 and 9 at these sizes only (default: all of them; ignored with --quick)")
     ap.add_argument("--repeat", type=int, default=3,
                     help="runs of rows 1 to 5, alternating slidernet and C, reported as medians (default 3)")
     ap.add_argument("--paper", action="store_true",
@@ -637,7 +641,9 @@ def main(argv: list[str] | None = None) -> int:
         # 8. irregular networks against network.c, the same network (written by slidernet), kernel alone
         if "irregular" in rows and not args.no_irregular_c:
             irr_rates: dict[int, tuple[float, float | None]] = {}
-            for nodes, steps in IRREGULAR_Q if q else IRREGULAR:
+            sizes_c = IRREGULAR_Q if q else [(m, s) for m, s in IRREGULAR
+                                             if args.irregular_nodes is None or m in args.irregular_nodes]
+            for nodes, steps in sizes_c:
                 file = str(Path(tmp) / f"irregular_{nodes}.txt")
                 ours_i, theirs_i, r_i, r_c_i = repeated(
                     n, lambda nodes=nodes, steps=steps, file=file: run_child(
