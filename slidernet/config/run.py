@@ -15,6 +15,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from slidernet.config.base import Integer, Seed, _Strict
 from slidernet.config.creep import CreepConfig
+from slidernet.config.dynamics import DynamicsConfig
 from slidernet.config.execution import ExecutionConfig
 from slidernet.config.network import NetworkConfig
 from slidernet.config.plugins import (
@@ -60,7 +61,7 @@ class Config(_Strict):
 
     # "plugins" too: a configuration without it dumps as it did before the key existed, so that
     # stored results and interrupted runs (run.json) still match it.
-    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt", "shs")
+    _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt", "shs", "dynamics")
 
     seed: Seed | None = Field(
         None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
@@ -88,6 +89,9 @@ class Config(_Strict):
     driver: PluginSpec = Field(
         description="The temperature driver theta(t): a registered name and its parameters.")
     solver: SolverConfig = Field(default_factory=SolverConfig, description="Choices of the solver.")
+    dynamics: DynamicsConfig | None = Field(
+        None, description="Sliders with mass: the equations of motion, integrated by the inertial solver "
+                          "([dynamics] tau_ratio); None: the quasi-static solver.")
     execution: ExecutionConfig = Field(
         default_factory=ExecutionConfig,
         description="Where the realizations run; never changes a result, and not part of a run's identity.")
@@ -149,6 +153,8 @@ class Config(_Strict):
 
     @model_validator(mode="after")
     def _check_cross_fields(self) -> Config:
+        if self.dynamics is not None:
+            self._check_dynamics()  # first: its reasons are the ones that hold with [dynamics]
         if isinstance(self.record, list):
             if any(t > self.steps for t in self.record):
                 raise ValueError(f"the 'record' times must lie in [0, steps = {self.steps}]")
@@ -222,6 +228,25 @@ class Config(_Strict):
             raise ValueError("'tilt.inject' with select < 1 raises the oldest contacts, whose ages need a network "
                              "kernel; use 'solver.kernel = \"auto\"' or '\"csr\"'")
 
+    def _check_dynamics(self) -> None:
+        """What the inertial solver does not model, refused with the reason (docs/guides/inertia.md)."""
+        refused = [
+            (self.solver.kernel != "auto", "'solver.kernel' names a quasi-static kernel; leave it \"auto\""),
+            (self.solver.slip != "straight", "'solver.slip' chooses the quasi-static 2D slip; the equations of "
+                                             "motion make their own"),
+            (self.friction.overshoot is not None, "'friction.overshoot' sets a quasi-static slip's length; the "
+                                                  "equations of motion make their own"),
+            (self.friction.strengthening is not None, "[friction.strengthening] is not modelled with inertia"),
+            (self.mu_eff_at == "rearrangements", "'mu_eff_at = \"rearrangements\"' (the appendix's test before "
+                                                 "every rearrangement) needs the quasi-static pair kernel; use "
+                                                 "'records'"),
+        ]
+        refused += [(name in self.observables, f"the {name!r} observable is not recorded with inertia")
+                    for name in ("creep", "mu_shs")]
+        for bad, why in refused:
+            if bad:
+                raise ValueError(f"with [dynamics] (the inertial solver), {why}")
+
     def _no_network_tilt_test(self) -> str | None:
         """Why this run makes no network tilt test at the recorded times, and what to set; None if it makes one."""
         if "mu_eff" not in self.observables:
@@ -290,7 +315,7 @@ class Config(_Strict):
         (:func:`~slidernet.model.network.pair_tilt_applies` of ``network``, or of the configured one,
         :meth:`NetworkConfig.pair_tilt_applies`) whose thresholds do not strengthen (its test reads the
         pair kernel's thresholds, which have no age)."""
-        if self.friction.strengthening is not None:
+        if self.friction.strengthening is not None or self.dynamics is not None:
             return False
         return self.network.pair_tilt_applies() if network is None else pair_tilt_applies(network)
 

@@ -343,6 +343,26 @@ def redraw_threshold(st, i, mu, mu_draws, node_slips):
 
 
 @kernel_jit(forceinline=True)
+def replace_threshold(mu, i, new, best):
+    """mu[i] = new, keeping ``best`` = (mu_max, its holder, n_records) as :func:`redraw_threshold` keeps
+    st.mu_max, st.argmax and st.n_records: the inertial solvers' record statistics (float64, shape (3,);
+    the holder and the count are exact integers in float64)."""
+    old = mu[i]
+    mu[i] = new
+    if new > best[0]:
+        best[2] += 1.0
+        best[0] = new
+        best[1] = i
+    elif i == int(best[1]) and new < old:
+        top = 0
+        for j in range(mu.size):
+            if mu[j] > mu[top]:
+                top = j
+        best[1] = top
+        best[0] = mu[top]
+
+
+@kernel_jit(forceinline=True)
 def log_event(st, catalogue, i, dux, duy):
     """Append the slip of node i to the event catalogue, if it is recorded.
 

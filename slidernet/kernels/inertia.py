@@ -35,6 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from slidernet.kernels.heap import replace_threshold
 from slidernet.kernels.inertia_phase import NO_EVENT, START, STOP, force, phase
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.state import DONE, NEED_EVENTS, NEED_MU
@@ -69,6 +70,7 @@ class Motion(NamedTuple):
     start_t: np.ndarray
     start_clock: np.ndarray
     start_u: np.ndarray
+    best: np.ndarray  # (3,): the running mu_max, its holder and n_records (kernels.heap.replace_threshold)
 
 
 
@@ -195,7 +197,7 @@ def after_phase(net, f_ext, mo, istate, fstate, log, draws, what, node, dtheta, 
         log.slip_du[k] = mo.u[i] - mo.start_u[i]
         istate[I_SLIPS] = k + 1
         # A new place on the substrate: a new threshold.
-        mo.mu[i] = draws[istate[I_POS]]
+        replace_threshold(mo.mu, i, draws[istate[I_POS]], mo.best)
         istate[I_POS] += 1
         mo.lim[i] = mo.mu[i] * net.normal_load[i]
     elif what == START:

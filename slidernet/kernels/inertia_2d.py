@@ -34,28 +34,25 @@ and recomputed only when the node's force offset a_j changes), which bounds
 the phase. When nothing moves, the next start is the first such crossing,
 in closed form.
 
-**Events.** A moving node stops when SS - |v_i| rises through 0 (SS =
-``STOP_SPEED``); a stuck neighbour starts when max_W (|F_j| - mu_s,j N_j)
-rises through 0; the phase ends at the end of the thermal step. A sign
-change between the ends of an accepted step brackets the event, and its
-time is found by the Illinois (safeguarded secant) method, each evaluation
-being the Dormand-Prince step from the step's start to the trial time: the
-state at the event is a full step of the scheme, not an interpolant, and the
-root is located to 1e-14 of the phase's time or to a zero event value.
+**Events.** A moving node stops when SS - |v_i| rises through 0 (SS = ``STOP_SPEED``); a stuck neighbour starts
+when max_W (|F_j| - mu_s,j N_j) rises through 0; the phase ends at the end of the thermal step. A sign change
+between the ends of an accepted step brackets the event, and its time is found by the Illinois (safeguarded secant)
+method, each evaluation being the Dormand-Prince step from the step's start to the trial time: the state at the
+event is a full step of the scheme, not an interpolant, and the root is located to 1e-14 of the phase's time or to
+a zero event value.
 
-**The traps.** (1) The stop: v_i / |v_i| is singular at v_i = 0 and the
-motion chatters about it without a sign change, so the stop is at |v_i| = SS
-(the reference's rule: ~SS / 0.1 tau_dyn and SS^2 / 0.2 Ntilde l0 early).
-(2) A node that starts has |v_i| < SS: it is armed for a stop once its speed
-has been above SS at the end of a step. (3) A speed that dips below SS and
-rises again within one step (a node pushed on by a neighbour): where d|v_i|/ds
-goes from < 0 to > 0 across a step, its minimum is located and, if below SS,
-the stop is found before it. (4) At v_i = 0 friction points along -F_i /
-|F_i|, the start direction; the first step after a start is ``H_START``.
-(5) Restarts and simultaneous starts: after every event the candidates (the
-stopped node, the stuck neighbours of M) above their thresholds start, the
-largest |F_j| / (mu_s,j N_j) first, as the reference's ``_start_overloaded``;
-each restart is a phase of its own (no step of zero length).
+**The traps.** (1) The stop: v_i / |v_i| is singular at v_i = 0 and the motion chatters about it without a sign
+change, so the stop is at |v_i| = SS (the reference's rule: ~SS / 0.1 tau_dyn and SS^2 / 0.2 Ntilde l0 early). (2)
+A node that starts has |v_i| < SS: it is armed for a stop once its speed has been above SS at the end of a step.
+(3) A speed that dips below SS and rises again within one step (a node pushed on by a neighbour): where d|v_i|/ds
+goes from < 0 to > 0 across a step, its minimum is located and, if below SS, the stop is found before it. (4) Until
+a node is armed, friction acts along -sigma_i, the direction of F_i at its start, not along -v_i / |v_i|: below SS
+that direction is stiff (rate mu_d / |v_i|), and a node whose mu_s lies a hair above mu_d (mu_s - mu_d = 7e-4 on a
+4 x 4 lattice at ratio 0.3) crept for ever at |v_i| ~ 1e-11 on the stability limit of the explicit steps, its v_i
+20 degrees off F_i. The first step after a start is ``H_START``. (5) Restarts and simultaneous starts: after every
+event the candidates (the stopped node, the stuck neighbours of M) above their thresholds start, the largest |F_j|
+/ (mu_s,j N_j) first, as the reference's ``_start_overloaded``; each restart is a phase of its own (no step of zero
+length).
 
 **Energy.** Each moving node also integrates its path length, int |v_i| ds,
 and the work of the thermal load on it, int (theta - theta(0)) g_i . v_i ds;
@@ -63,14 +60,12 @@ E = (1/2) u.K u - u.f_ext changes by the exact quadratic form of each phase's
 displacements. Per avalanche, work = dE + sum_i mu_d N_i path_i + the kinetic
 energy (1/2) N_i |v_i|^2 <= (1/2) N_i SS^2 dropped at each stop.
 
-**Cost.** 180 to 200 steps per slip at rtol = 1e-10, ~0.35 us each
-(benchmarks/inertia_2d_speed.py): ~60 % in the half-oscillation at h ~
-0.013 tau_dyn, the rest near the ends of a slip, where the steps grow in
-proportion to the time since the start and shrink with the time to the stop
-(the friction's part across v_i is stiff, rate mu_d / |v_i|). DOP853 takes
-half the steps with twice the stages (scipy's, measured). The helpers called
-at each step are inlined: a call passing the net, run, motion and work
-tuples flattens their ~40 arrays into hundreds of arguments.
+**Cost.** 180 to 200 steps per slip at rtol = 1e-10, ~0.35 us each (benchmarks/inertia_2d_speed.py): ~60 %
+in the half-oscillation at h ~ 0.013 tau_dyn, the rest near the ends of a slip, where the steps grow in
+proportion to the time since the start and shrink with the time to the stop (the friction's part across v_i
+is stiff, rate mu_d / |v_i|). DOP853 takes half the steps with twice the stages (scipy's, measured). The
+helpers called at each step are inlined: a call passing the net, run, motion and work tuples flattens their
+~40 arrays into hundreds of arguments.
 """
 
 from __future__ import annotations
@@ -80,6 +75,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from slidernet.kernels.heap import replace_threshold
 from slidernet.kernels.jit import kernel_jit
 from slidernet.kernels.plane import block_of, critical_thetas
 
@@ -150,6 +146,7 @@ class Motion(NamedTuple):
     path: np.ndarray  # (N,) path length of the current slip, Ntilde l0
     mark: np.ndarray  # (N,) int64: local index in M of a moving node, -1 otherwise
     wmark: np.ndarray  # (N,) int64: local index in W of a watched stuck node, -1 otherwise
+    best: np.ndarray  # (3,) the running mu_max, its holder and n_records (kernels.heap.replace_threshold)
 
 
 class Work(NamedTuple):
@@ -217,7 +214,7 @@ def rhs(net, run, mo, wk, m, theta0, r, s, Y, out):
         vx = Y[k, VX]
         vy = Y[k, VY]
         sp = _norm(vx, vy)
-        if sp > 0.0:
+        if mo.armed[i] and sp > 0.0:
             dx = vx / sp
             dy = vy / sp
         else:
@@ -669,7 +666,7 @@ def after_phase(net, run, mo, wk, out, floats, ints, mu_buf, event, node, nw, th
         out.slip_node[r] = i
         ints[N_SLIPS] = r + 1
         # A new place on the substrate: a new threshold.
-        mo.mu[i] = mu_buf[ints[POS]]
+        replace_threshold(mo.mu, i, mu_buf[ints[POS]], mo.best)
         ints[POS] += 1
         mo.lim[i] = mo.mu[i] * net.normal_load[i]
         node_crit(net, mo, i)

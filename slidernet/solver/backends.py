@@ -24,7 +24,9 @@ Backends:
 
 - :class:`PairBackend` (``pair``): the paper's two sliders, scalars only;
 - :class:`ChainBackend` (``csr``): any 1D network, CSR rows of K;
-- :class:`PlaneBackend` (``vec``): any 2D network, 2 x 2 blocks of K.
+- :class:`PlaneBackend` (``vec``): any 2D network, 2 x 2 blocks of K;
+- with ``[dynamics]``, the inertial solver's :class:`~slidernet.solver.inertia_backends.InertiaBackend`
+  (``inertia``, 1D) and :class:`~slidernet.solver.inertia_backends.Inertia2DBackend` (``inertia_2d``).
 
 The two network backends run the same driving loop, :func:`slidernet.kernels.network.run_network`,
 on their operators (:class:`~slidernet.kernels.Chain` or :class:`~slidernet.kernels.Plane`). Each
@@ -43,6 +45,7 @@ import numpy as np
 from slidernet import kernels
 from slidernet.errors import SnapshotError
 from slidernet.kernels.heap import theta_time
+from slidernet.solver.inertia_backends import Inertia2DBackend, InertiaBackend
 from slidernet.solver.scene import EVENT_CHUNK, SLIP_EXACT, Scene
 from slidernet.solver.snapshot import take
 
@@ -372,11 +375,11 @@ def state_time(real: Host) -> float:
 
 
 # The one place where a kernel's name is read: the scene's choice picks the backend.
-BACKENDS: dict[str, type[PairBackend] | type[NetworkBackend]] = {
-    b.kernel: b for b in (PairBackend, ChainBackend, PlaneBackend)
+BACKENDS: dict[str, type[PairBackend] | type[NetworkBackend] | type[InertiaBackend] | type[Inertia2DBackend]] = {
+    b.kernel: b for b in (PairBackend, ChainBackend, PlaneBackend, InertiaBackend, Inertia2DBackend)
 }
 
 
-def backend_for(scene: Scene, real: Host) -> PairBackend | NetworkBackend:
+def backend_for(scene: Scene, real: Host) -> PairBackend | NetworkBackend | InertiaBackend | Inertia2DBackend:
     """The backend of ``scene``'s kernel, with its state built for ``real``."""
     return BACKENDS[scene.kernel](scene, real)

@@ -53,6 +53,8 @@ _COMPILE_SECONDS = {
     "network tilt test": 7.0,
     # Not timed from an empty cache: taken as the network tilt test's (the same body, another variant).
     "slide-hold-slide": 7.0,
+    "inertial solver (1D)": 20.0,
+    "inertial solver (2D)": 20.0,
 }
 
 

@@ -126,10 +126,8 @@ class InertialSolver:
         thetas, mu, batches = horizontal_draws(scene, realization_streams(seed_seq))
         N = net.n_nodes
         rec = scene.out_steps[scene.out_steps <= steps].astype(np.int64)
-        mo = kin.Motion(u=np.zeros(N), v=np.zeros(N), sig=np.zeros(N), mu=mu.copy(),
-                        lim=mu * net.normal_load, moving=np.zeros(N, np.int64), start_t=np.zeros(N),
-                        start_clock=np.zeros(N), start_u=np.zeros(N))
-        log = _new_log(rec.size, LOG_ROWS)
+        mo = new_motion(mu.copy(), net.normal_load)
+        log = new_log(rec.size, LOG_ROWS)
         istate = np.zeros(10, np.int64)
         fstate = np.zeros(6)
         draws = np.empty(0)
@@ -144,12 +142,9 @@ class InertialSolver:
                 draws = next(batches)
                 istate[kin.I_POS] = 0
             elif code == NEED_EVENTS:
-                log = _grow_log(log)
+                log = grow_log(log)
             else:  # RUNAWAY
-                raise AvalancheError(
-                    f"Node {int(istate[kin.I_NODE])} has been sliding for {kin.MAX_SLIP_DURATION:g} tau_dyn "
-                    f"without stopping (t = {float(fstate[kin.F_T])!r} tau_th): a load f_ext that friction "
-                    "cannot hold makes the network slide for ever; lower f_ext.")
+                raise runaway_error(int(istate[kin.I_NODE]), float(fstate[kin.F_T]))
         Ntilde = net.Ntilde
         S = int(istate[kin.I_SLIPS])
         A = int(istate[kin.I_AVAL])
@@ -180,15 +175,33 @@ class InertialSolver:
         }
 
 
-def _new_log(records: int, rows: int) -> kin.Log:
+def runaway_error(node: int, t: float) -> AvalancheError:
+    """The error of a node that slid MAX_SLIP_DURATION tau_dyn without stopping, at time t (tau_th)."""
+    return AvalancheError(
+        f"Node {node} has been sliding for {kin.MAX_SLIP_DURATION:g} tau_dyn without stopping (t = {t!r} tau_th): "
+        "a load f_ext that friction cannot hold makes the network slide for ever; lower f_ext.")
+
+
+def new_motion(mu: np.ndarray, normal_load: np.ndarray) -> kin.Motion:
+    """The nodes at rest at u = 0 with thresholds ``mu`` (held, not copied: the kernel writes its draws there)
+    and normal loads N_i, shape (N,) each."""
+    N = mu.size
+    top = int(np.argmax(mu))
+    return kin.Motion(u=np.zeros(N), v=np.zeros(N), sig=np.zeros(N), mu=mu, lim=mu * normal_load,
+                      moving=np.zeros(N, np.int64), start_t=np.zeros(N), start_clock=np.zeros(N),
+                      start_u=np.zeros(N), best=np.array([mu[top], top, 0.0]))
+
+
+def new_log(records: int, rows: int) -> kin.Log:
     f = np.zeros
+    """A log of ``records`` recorded times and ``rows`` rows of slips and of avalanches."""
     return kin.Log(out_n=f(records, np.int64), out_mu_max=f(records), out_xg=f(records),
                    slip_start=f(rows), slip_end=f(rows), slip_duration=f(rows), slip_node=f(rows, np.int64),
                    slip_du=f(rows), av_start=f(rows), av_end=f(rows), av_work=f(rows), av_e0=f(rows),
                    av_e1=f(rows), av_slips=f(rows, np.int64))
 
 
-def _grow_log(log: kin.Log) -> kin.Log:
+def grow_log(log: kin.Log) -> kin.Log:
     """The log with its slip and avalanche rows doubled (the records kept as they are)."""
     grown = {}
     for name, array in log._asdict().items():

@@ -15,8 +15,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from slidernet.errors import AvalancheError, ConfigError, param_error
+from slidernet.errors import ConfigError, param_error
 from slidernet.kernels import inertia_2d as kern
+from slidernet.solver.inertia import runaway_error
 from slidernet.solver.scene import Scene
 from slidernet.solver.streams import horizontal_draws, realization_streams
 
@@ -51,6 +52,49 @@ class Run(NamedTuple):
     atol: float
     max_step: float  # tau_dyn
     steps: int
+
+
+def new_motion(scene: Scene, mu: np.ndarray, theta0: float) -> tuple[kern.Motion, kern.Work]:
+    """The nodes at rest at u = 0 with thresholds ``mu`` (shape (N,), held, not copied: the kernel writes its
+    draws there) and theta(0) = ``theta0`` (Ntilde), their stable ranges computed; and the scratch of a phase."""
+    net = scene.operators
+    n_nodes = mu.size
+    nnz = net.indices.size
+    f_ext = np.asarray(scene.network.f_ext, dtype=np.float64).reshape(n_nodes, 2)
+    top = int(np.argmax(mu))
+    mo = kern.Motion(
+        u=np.zeros((n_nodes, 2)), v=np.zeros((n_nodes, 2)), a=f_ext - net.g * theta0,
+        sigma=np.zeros((n_nodes, 2)), mu=mu, lim=mu * net.normal_load, crit=np.zeros((n_nodes, 2)),
+        moving=np.zeros(n_nodes, np.int8), armed=np.zeros(n_nodes, np.int8), start_t=np.zeros(n_nodes),
+        start_clock=np.zeros(n_nodes), start_u=np.zeros((n_nodes, 2)), path=np.zeros(n_nodes),
+        mark=np.full(n_nodes, -1, np.int64), wmark=np.full(n_nodes, -1, np.int64),
+        best=np.array([mu[top], top, 0.0]))
+    wk = kern.Work(
+        M=np.zeros(n_nodes, np.int64), W=np.zeros(n_nodes, np.int64), mptr=np.zeros(n_nodes + 1, np.int64),
+        mcol=np.zeros(nnz, np.int64), mblk=np.zeros(nnz, np.int64), wptr=np.zeros(n_nodes + 1, np.int64),
+        wcol=np.zeros(nnz, np.int64), wblk=np.zeros(nnz, np.int64), F0=np.zeros((n_nodes, 2)),
+        FW=np.zeros((n_nodes, 2)), Y=np.zeros((n_nodes, kern.N_COMP)), Yt=np.zeros((n_nodes, kern.N_COMP)),
+        Ks=np.zeros((7, n_nodes, kern.N_COMP)),
+        cand=np.zeros(n_nodes, np.int64), over=np.zeros(n_nodes))
+    for j in range(n_nodes):
+        kern.node_crit(net, mo, j)
+    return mo, wk
+
+
+def new_out(n: np.ndarray, mu_max: np.ndarray, x_G: np.ndarray) -> Out:
+    """The kernel's output: the records ``n``, ``mu_max``, ``x_G`` (shape (T,), held, not copied) and
+    empty slip and avalanche buffers of OUT_CHUNK rows."""
+    return Out(n=n, mu_max=mu_max, x_G=x_G, slip_f=np.zeros((OUT_CHUNK, 6)),
+               slip_node=np.zeros(OUT_CHUNK, np.int64), av_f=np.zeros((OUT_CHUNK, 6)),
+               av_n=np.zeros(OUT_CHUNK, np.int64))
+
+
+def new_scalars(max_step: float) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's float and integer scalars at the start of a realization (the first step: 0.01 tau_dyn
+    or ``max_step``)."""
+    floats = np.zeros(kern.N_FLOATS)
+    floats[kern.H] = min(0.01, max_step)
+    return floats, np.zeros(kern.N_INTS, np.int64)
 
 
 class Inertia2D:
@@ -136,33 +180,12 @@ class Inertia2D:
             raise param_error("steps", "Inertia2D.run", f"an integer in [0, {scene.steps}]", steps)
         thetas, mu, batches = horizontal_draws(scene, realization_streams(seed_seq))
         net = scene.operators
-        n_nodes = mu.size
-        nnz = net.indices.size
-        f_ext = np.asarray(scene.network.f_ext, dtype=np.float64).reshape(n_nodes, 2)
-        mo = kern.Motion(
-            u=np.zeros((n_nodes, 2)), v=np.zeros((n_nodes, 2)), a=f_ext - net.g * thetas[0],
-            sigma=np.zeros((n_nodes, 2)), mu=mu, lim=mu * net.normal_load, crit=np.zeros((n_nodes, 2)),
-            moving=np.zeros(n_nodes, np.int8), armed=np.zeros(n_nodes, np.int8), start_t=np.zeros(n_nodes),
-            start_clock=np.zeros(n_nodes), start_u=np.zeros((n_nodes, 2)), path=np.zeros(n_nodes),
-            mark=np.full(n_nodes, -1, np.int64), wmark=np.full(n_nodes, -1, np.int64))
-        wk = kern.Work(
-            M=np.zeros(n_nodes, np.int64), W=np.zeros(n_nodes, np.int64), mptr=np.zeros(n_nodes + 1, np.int64),
-            mcol=np.zeros(nnz, np.int64), mblk=np.zeros(nnz, np.int64), wptr=np.zeros(n_nodes + 1, np.int64),
-            wcol=np.zeros(nnz, np.int64), wblk=np.zeros(nnz, np.int64), F0=np.zeros((n_nodes, 2)),
-            FW=np.zeros((n_nodes, 2)), Y=np.zeros((n_nodes, kern.N_COMP)), Yt=np.zeros((n_nodes, kern.N_COMP)),
-            Ks=np.zeros((7, n_nodes, kern.N_COMP)),
-            cand=np.zeros(n_nodes, np.int64), over=np.zeros(n_nodes))
+        mo, wk = new_motion(scene, mu, thetas[0])
         rec = scene.out_steps[scene.out_steps <= steps]
-        out = Out(n=np.zeros(rec.size, np.int64), mu_max=np.zeros(rec.size), x_G=np.zeros(rec.size),
-                       slip_f=np.zeros((OUT_CHUNK, 6)), slip_node=np.zeros(OUT_CHUNK, np.int64),
-                       av_f=np.zeros((OUT_CHUNK, 6)), av_n=np.zeros(OUT_CHUNK, np.int64))
+        out = new_out(np.zeros(rec.size, np.int64), np.zeros(rec.size), np.zeros(rec.size))
         run = Run(mu_d=float(scene.mu_d), tau=self.tau_ratio, rtol=self.rtol, atol=1e-2 * self.rtol,
                        max_step=self.max_step, steps=int(steps))
-        floats = np.zeros(kern.N_FLOATS)
-        floats[kern.H] = min(0.01, self.max_step)
-        ints = np.zeros(kern.N_INTS, np.int64)
-        for j in range(n_nodes):
-            kern.node_crit(net, mo, j)
+        floats, ints = new_scalars(self.max_step)
         mu_buf = np.empty(0)
         ints[kern.POS] = 0
         slips: list[np.ndarray] = []
@@ -185,12 +208,7 @@ class Inertia2D:
             if code == kern.DONE:
                 break
             if code == kern.RUNAWAY:
-                i = int(ints[kern.RUNAWAY_NODE])
-                raise AvalancheError(
-                    f"Node {i} has been sliding for {kern.MAX_SLIP_DURATION:g} tau_dyn without stopping "
-                    f"(t = {float(floats[kern.T])!r} tau_th): a load f_ext that friction cannot hold makes the "
-                    "network slide for ever; lower f_ext."
-                )
+                raise runaway_error(int(ints[kern.RUNAWAY_NODE]), float(floats[kern.T]))
         Ntilde = scene.network.Ntilde
         slip = np.concatenate(slips)
         av = np.concatenate(avs)

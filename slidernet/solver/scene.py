@@ -179,15 +179,29 @@ class ShsOperators(NamedTuple):
     test: Callable[..., float]  # the compiled pull of the scene's slip rule (shs_test_network or its _exact)
 
 
+#: The inertial solver's kernel of each dimension (a scene with [dynamics] runs on it, whatever the network).
+INERTIAL_KERNELS = {1: "inertia", 2: "inertia_2d"}
+
+
+class Dynamics(NamedTuple):
+    """The ``[dynamics]`` table as the inertial solver takes it."""
+
+    tau_ratio: float  # tau_dyn / tau_th
+    rtol: float  # 2D: relative error per step
+    max_step: float  # 2D: longest step, tau_dyn
+
+
 @dataclass
 class Scene:
     """Everything a realization needs, derived once from a :class:`Config`.
 
     Attributes
     ----------
-    kernel : {"pair", "csr", "vec"}
+    kernel : {"pair", "csr", "vec", "inertia", "inertia_2d"}
         The specialized kernel picked for this scene: ``pair`` for the
-        paper's two sliders, ``csr`` for other 1D networks, ``vec`` in 2D.
+        paper's two sliders, ``csr`` for other 1D networks, ``vec`` in 2D;
+        with ``[dynamics]``, the inertial solver's ``inertia`` (1D, the pair
+        included) or ``inertia_2d``.
     operators : Chain or Plane
         The network's operators the kernels run on (see ``_operators``).
     K : scipy.sparse matrix
@@ -230,6 +244,7 @@ class Scene:
     tilt_repeats: int = 1  # network tilt tests per recorded time ([tilt] repeats)
     inject: InjectConfig | None = None  # the aging injected into the tested copy ([tilt] inject); None: none
     operators: Chain | Plane | None = None
+    dynamics: Dynamics | None = None  # [dynamics]: the inertial solver's settings; None: quasi-static
     _tilt_operators: TiltOperators | None = field(default=None, repr=False)
     _shs_operators: ShsOperators | None = field(default=None, repr=False)
     _K: Any = field(default=None, repr=False)
@@ -293,7 +308,15 @@ class Scene:
         catalogue = cfg.needs_catalogue()
         two_slider = net.is_two_slider()
         kernel = choose_kernel(cfg.solver.kernel, two_slider, net.dim, cfg.needs_node_state())
-        if kernel != family and not (kernel == "pair" and two_slider):
+        dyn = cfg.dynamics
+        if dyn is not None:
+            kernel = INERTIAL_KERNELS[net.dim]
+            if mean_load(net) > cfg.friction.mu_d:
+                raise ConfigError(
+                    f"With [dynamics] (the inertial solver) the load along x per unit normal load "
+                    f"({mean_load(net)!r}) must not exceed mu_d = {cfg.friction.mu_d!r}: the network would slide "
+                    "away, which only the quasi-static solver records.")
+        elif kernel != family and not (kernel == "pair" and two_slider):
             raise ConfigError(
                 f"The 'solver.kernel' value {kernel!r} cannot run this network; use {family!r}."
             )
@@ -348,6 +371,7 @@ class Scene:
             inject=tilt.inject if cfg.injected_tests() else None,
             shs_stiffness=cfg.shs_settings().stiffness if "mu_shs" in cfg.observables else None,
             operators=operators,
+            dynamics=None if dyn is None else Dynamics(float(dyn.tau_ratio), float(dyn.rtol), float(dyn.max_step)),
         )
         if scene.shs_stiffness is not None:
             scene.shs_operators()  # built now: pull springs that float64 cannot hold are refused before any work

@@ -115,6 +115,8 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         **({} if scene.inject is None else {"inject": scene.inject.model_dump(mode="json")}),
         # Only with the slide-hold-slide pull, likewise.
         **({} if scene.shs_stiffness is None else {"shs_stiffness": float(scene.shs_stiffness)}),
+        # And the inertial solver's settings, with [dynamics].
+        **({} if scene.dynamics is None else {"dynamics": [float(x) for x in scene.dynamics]}),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": digest(*(getattr(ops, name) for name in _K_FIELDS if name in ops._fields)),

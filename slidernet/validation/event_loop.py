@@ -385,11 +385,14 @@ class EventLoop:
                 z[-2] = s
                 out = B @ z
                 # Friction along -v_i/|v_i| (per unit mass mu_d, as m_i = N_i m), not along -sigma_i:
-                # B holds the part along sigma_i, this the difference. At v_i = 0 (a node starting) the
-                # direction is sigma_i, the force's.
+                # B holds the part along sigma_i, this the difference. Below STOP_SPEED (a node starting:
+                # one that slows down to it stops there) the direction is sigma_i, the force's at the
+                # start: there v_i / |v_i| is stiff (rate mu_d / |v_i|), and a node whose mu_s lies a hair
+                # above mu_d crept for ever.
                 v = y[m:]
                 speed = np.repeat(node_norms(v, dim), dim)
-                out[m:] -= mu_d * np.where(speed > 0.0, v / np.where(speed > 0.0, speed, 1.0) - sig, 0.0)
+                fast = speed >= STOP_SPEED
+                out[m:] -= mu_d * np.where(fast, v / np.where(fast, speed, 1.0) - sig, 0.0)
                 return out
 
         if dim == 1:
