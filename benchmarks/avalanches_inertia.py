@@ -64,6 +64,7 @@ from slidernet.solver import Scene, simulate
 NTILDE = 1e-7
 MU_D = 0.5
 MU_S = 0.6
+MIN_CURVE = 100  # avalanches below which the figure names a solver without drawing its P(S)
 
 
 def make_scene(n: int, sigma: float, ratio: float, steps: int, network: dict | None = None,
@@ -148,10 +149,13 @@ def log2_edges(largest: int) -> np.ndarray:
 
 def densities(sizes: Sequence[np.ndarray], edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """P(S) per unit S in each bin, per realization (each normalized to its own avalanches), and its mean and
-    standard error over realizations; shape (B,) each (NaN error with one realization)."""
+    standard error over the realizations that have avalanches (one without any has no P(S); counting it as
+    zero would lower the density); shape (B,) each (NaN error with fewer than two such realizations)."""
     width = np.diff(edges)
-    per = np.array([np.histogram(s, edges)[0] / max(s.size, 1) / width for s in sizes])
-    sem = per.std(axis=0, ddof=1) / math.sqrt(len(sizes)) if len(sizes) > 1 else np.full(width.size, np.nan)
+    per = np.array([np.histogram(s, edges)[0] / s.size / width for s in sizes if s.size]).reshape(-1, width.size)
+    if not len(per):
+        return np.full(width.size, np.nan), np.full(width.size, np.nan)
+    sem = per.std(axis=0, ddof=1) / math.sqrt(len(per)) if len(per) > 1 else np.full(width.size, np.nan)
     return per.mean(axis=0), sem
 
 
@@ -304,11 +308,13 @@ def figure(data: dict[str, Any], path: str) -> None:
     centre = np.sqrt(edges[:-1] * edges[1:])
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for key, s in data["summary"].items():
-        if not s.get("realizations"):
+        label = "quasi-static" if key == "qs" else f"inertial, $\\tau_{{dyn}}/\\tau_{{th}}$ = {key}"
+        if s.get("avalanches", 0) < MIN_CURVE:
+            # A handful of ended motions is no distribution: named in the legend, not drawn.
+            ax.plot([], [], " ", label=f"{label}: {s.get('avalanches', 0)} avalanches ended, not drawn")
             continue
         d, e = np.asarray(s["density"]), np.asarray(s["density_sem"])
         keep = d > 0
-        label = "quasi-static" if key == "qs" else f"inertial, $\\tau_{{dyn}}/\\tau_{{th}}$ = {key}"
         label += f" ($\\tau_S$ = {s['tau_S']:.2f} ± {s['tau_S_sem']:.2f})"
         e = np.nan_to_num(e[keep])
         # The lower bar clipped above zero: a log axis cannot show a bar that reaches it.

@@ -78,3 +78,14 @@ def test_exponent_and_its_error_over_realizations() -> None:
     density, density_sem = av.densities(sizes, edges)
     assert (density * np.diff(edges)).sum() == pytest.approx(1.0)
     assert density_sem.shape == density.shape
+
+
+def test_a_realization_without_avalanches_has_no_density() -> None:
+    """A realization in which no motion ended (the network moved to the end) is left out of P(S): the mean
+    density over the others stays normalized, instead of falling to (non-empty) / (all) of it."""
+    edges = av.log2_edges(8)
+    sizes = [np.array([1, 1, 2, 5]), np.array([], dtype=np.int64), np.array([1, 3, 8])]
+    density, density_sem = av.densities(sizes, edges)
+    assert (density * np.diff(edges)).sum() == pytest.approx(1.0)
+    assert np.isfinite(density_sem).all()
+    assert np.isnan(av.densities([np.array([], dtype=np.int64)], edges)[0]).all()
