@@ -82,7 +82,9 @@ def run_point(n: int, geometry: int, realizations: int, steps: int, tau: float |
     where = out / "points" / f"n{n}_g{geometry}_tau{'qs' if tau is None else f'{tau:g}'}"
     cfg = config(n, geometry, realizations, steps, tau)
     cfg["execution"] = {"workers": workers} if workers else {}
-    # The run's own folder: checkpoints, and a finished point read back on a rerun.
+    if (where / "result.nc").exists():  # a point an earlier run finished
+        return xr.load_dataset(where / "result.nc")
+    # The run's own folder: checkpoints, and an interrupted point resumed.
     return slidernet.run(cfg, out=where, resume=where.exists(), progress=False)
 
 
