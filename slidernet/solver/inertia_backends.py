@@ -25,7 +25,9 @@ observables as they come:
 
 The state at a recorded time may hold moving nodes (a motion that crosses
 t_q); the network tilt test then tests that configuration as it stands,
-every node held where it is (docs/guides/inertia.md).
+every node held where it is (docs/guides/inertia.md), and so does the
+dynamic tilt test of ``[dynamics] tilt_rate``
+(:mod:`slidernet.solver.inertia_tilt`), each velocity set to zero.
 """
 
 from __future__ import annotations

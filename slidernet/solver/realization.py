@@ -248,7 +248,9 @@ class Realization:
         rule, which is the appendix's for a 1D pair) and returns the total
         tangential load per unit normal load at that moment, f plus the mean
         f_ext along x. The state is left as it was; the draws come from the
-        realization's tilt stream.
+        realization's tilt stream. With ``[dynamics] tilt_rate`` the test is
+        the dynamic one, the load ramped at that rate under the equations of
+        motion (:mod:`slidernet.solver.inertia_tilt`).
 
         Parameters
         ----------
