@@ -1,7 +1,7 @@
 """mu_eff of the dynamic tilt test against its ramp rate, and its zero-rate extrapolation.
 
     python benchmarks/dynamic_tilt_rate.py [--network pair] [--realizations 2000] [--steps 5]
-        [--rates 1e-4 2e-4 5e-4 1e-3 2e-3 5e-3 1e-2]
+        [--rates 1e-4 2e-4 5e-4 1e-3 2e-3 5e-3 1e-2] [--save PATH]
 
 One run of the configuration below per rate (``[dynamics] tilt_rate``) and
 one without it (the quasi-static network tilt test of the same states), the
@@ -11,7 +11,7 @@ realization. Prints mu_eff at each rate (mean and standard error over the
 realizations), the difference from the slowest rate, and the zero-rate
 extrapolations of :func:`slidernet.analysis.tilt_rate.zero_rate` (linear and
 power in the rate), with the zero-rate mu_eff less the quasi-static one,
-paired.
+paired. ``--save``: the samples, an .npz of ``rates``, ``mu_eff`` (R, K) and ``quasi_static`` (R,).
 
 The scene: ``--network`` ``pair`` (the paper's two sliders) or ``irregular16``
 (an irregular network of 16, seed 2); mu_d = 0.5, mu_s ~ N(0.6, 0.03^2),
@@ -50,10 +50,13 @@ def main() -> None:
     parser.add_argument("--realizations", type=int, default=2000)
     parser.add_argument("--steps", type=int, default=5)
     parser.add_argument("--rates", type=float, nargs="+", default=[1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2])
+    parser.add_argument("--save", help="an .npz file for the samples")
     args = parser.parse_args()
     rates = np.array(sorted(args.rates))
     M = np.stack([samples(args.network, args.realizations, args.steps, r) for r in rates], axis=1)
     qs = samples(args.network, args.realizations, args.steps, None)
+    if args.save:
+        np.savez(args.save, rates=rates, mu_eff=M, quasi_static=qs)
     sqrt_r = np.sqrt(M.shape[0])
     for k, r in enumerate(rates):
         d = M[:, k] - M[:, 0]

@@ -274,6 +274,7 @@ class Realization:
             if advance:
                 st["tilt_mu_pos"] = p_mu
             return f
+        self._dynamic_loads = None
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         (heaps, epoch, count, pos, loads), G = self._test_work("_tilt_work")
