@@ -7,7 +7,10 @@ motion (docs/model.md, "Inertia"): ``tau_ratio`` = tau_dyn / tau_th, with
 tau_dyn = sqrt(m / k) and a lone slip of the paper lasting pi tau_dyn. In
 1D the motion is exact between events; in 2D the moving nodes are
 integrated by a Dormand-Prince 5(4) scheme whose ``rtol`` and ``max_step``
-are set here (they never matter in 1D).
+are set here (they never matter in 1D). ``tilt_rate`` makes the tilt tests at
+the recorded times dynamic: the load ramped at that rate under the equations
+of motion (:mod:`slidernet.solver.inertia_tilt`); absent, they are the
+quasi-static network tilt test of the state at the recorded time.
 """
 
 from __future__ import annotations
@@ -36,3 +39,7 @@ class DynamicsConfig(_Strict):
     max_step: PositiveFloat = Field(
         0.1, description="2D only: the longest integration step, in tau_dyn; a stuck neighbour whose force rises "
                          "above its threshold and falls back within one step is not seen.")
+    tilt_rate: PositiveFloat | None = Field(
+        None, description="The dynamic tilt test's ramp: the load per unit normal load rises at this rate per "
+                          "tau_dyn (units of mu), under the equations of motion. Absent: the quasi-static network "
+                          "tilt test of the state at each recorded time.")

@@ -71,6 +71,12 @@ class Motion(NamedTuple):
     start_clock: np.ndarray
     start_u: np.ndarray
     best: np.ndarray  # (3,): the running mu_max, its holder and n_records (kernels.heap.replace_threshold)
+    # The dynamic tilt test's (slidernet.solver.inertia_tilt) watch, shape (N, 2) and (2,), or (0, 2) and (0,)
+    # where nothing watches (a run: no cost): each node's first start, [t (tau_th), |F_i| (N)]; the first time
+    # every node moved at once and the last start from rest (nothing moving before, not a restart), tau_th;
+    # NaN until they happen. Not part of a snapshot.
+    first: np.ndarray
+    times: np.ndarray
 
 
 
@@ -131,6 +137,18 @@ def start_node(mo, istate, fstate, i, F):
     mo.start_t[i] = fstate[F_T]
     mo.start_clock[i] = fstate[F_CLOCK]
     mo.start_u[i] = mo.u[i]
+    if mo.first.shape[0] > 0:
+        if math.isnan(mo.first[i, 0]):
+            mo.first[i, 0] = fstate[F_T]
+            mo.first[i, 1] = abs(F)
+        if math.isnan(mo.times[0]):
+            every = True
+            for j in range(mo.u.size):
+                if not mo.moving[j]:
+                    every = False
+                    break
+            if every:
+                mo.times[0] = fstate[F_T]
 
 
 @kernel_jit(forceinline=True)
@@ -326,6 +344,8 @@ def run_inertia(net, f_ext, mu_d, tau_ratio, thetas, rec, steps, mo, wk, log, dr
                     continue
                 fstate[F_T] = t + wait
                 theta = theta_a + rate * (fstate[F_T] - q)
+                if mo.times.size:
+                    mo.times[1] = fstate[F_T]
                 begin_avalanche(net, mo, fstate)
                 start_node(mo, istate, fstate, j_best, force(net, f_ext, mo.u, j_best, theta - theta0))
                 start_overloaded(net, f_ext, mo, istate, fstate, theta - theta0)

@@ -18,21 +18,16 @@ a = f_ext - K u - g theta(0)), v in Ntilde l0 per tau_dyn.
 
 How it is integrated
 --------------------
-**Phases.** Between two events the set M of moving nodes is fixed. The
-nodes of M are integrated together, by Dormand-Prince 5(4) with adaptive
-steps (:func:`dp_step`: error per step below ``atol + rtol |y_i|`` in every
-component of u and v of node i, |y_i| the largest of them, with ``atol =
-1e-2 rtol`` Ntilde l0 as the reference's; step at most ``max_step`` tau_dyn). Their right-hand side reads
-K only through the sparse rows of M (``K_MM``, gathered once per phase). A
-stuck node is exactly fixed: its force changes only through the moving
-nodes' displacements and theta, F_j(s) = F_j(0) - sum_{i in M} K_ji du_i(s)
-+ g_j dtheta/ds s, so only the stuck neighbours W of M (rows ``K_WM``) are
-evaluated at each step; every other stuck node is driven by theta alone, and
-its first crossing is the root of a quadratic in theta
-(:func:`slidernet.kernels.plane.critical_thetas`, kept per node in ``crit``
-and recomputed only when the node's force offset a_j changes), which bounds
-the phase. When nothing moves, the next start is the first such crossing,
-in closed form.
+**Phases.** Between two events the set M of moving nodes is fixed. The nodes of M are integrated together, by
+Dormand-Prince 5(4) with adaptive steps (:func:`dp_step`: error per step below ``atol + rtol |y_i|`` in every
+component of u and v of node i, |y_i| the largest of them, with ``atol = 1e-2 rtol`` Ntilde l0 as the reference's;
+step at most ``max_step`` tau_dyn). Their right-hand side reads K only through the sparse rows of M (``K_MM``,
+gathered once per phase). A stuck node is exactly fixed: its force changes only through the moving nodes'
+displacements and theta, F_j(s) = F_j(0) - sum_{i in M} K_ji du_i(s) + g_j dtheta/ds s, so only the stuck
+neighbours W of M (rows ``K_WM``) are evaluated at each step; every other stuck node is driven by theta alone, and
+its first crossing is the root of a quadratic in theta (:func:`slidernet.kernels.plane.critical_thetas`, kept per
+node in ``crit`` and recomputed only when the node's force offset a_j changes), which bounds the phase. When
+nothing moves, the next start is the first such crossing, in closed form.
 
 **Events.** A moving node stops when SS - |v_i| rises through 0 (SS = ``STOP_SPEED``); a stuck neighbour starts
 when max_W (|F_j| - mu_s,j N_j) rises through 0; the phase ends at the end of the thermal step. A sign change
@@ -147,6 +142,8 @@ class Motion(NamedTuple):
     mark: np.ndarray  # (N,) int64: local index in M of a moving node, -1 otherwise
     wmark: np.ndarray  # (N,) int64: local index in W of a watched stuck node, -1 otherwise
     best: np.ndarray  # (3,) the running mu_max, its holder and n_records (kernels.heap.replace_threshold)
+    first: np.ndarray  # (N, 2) or (0, 2): the dynamic tilt test's watch, as kernels.inertia.Motion's
+    times: np.ndarray  # (2,) or (0,)
 
 
 class Work(NamedTuple):
@@ -601,6 +598,10 @@ def start(net, mo, wk, floats, ints, i, theta):
     mo.start_u[i, 0] = mo.u[i, 0]
     mo.start_u[i, 1] = mo.u[i, 1]
     mo.path[i] = 0.0
+    if mo.first.shape[0] > 0 and math.isnan(mo.first[i, 0]):
+        mo.first[i, 0], mo.first[i, 1] = floats[T], norm
+    if mo.times.size and math.isnan(mo.times[0]) and ints[N_MOVING] == mo.mu.size:
+        mo.times[0] = floats[T]
 
 
 @kernel_jit()
@@ -793,5 +794,7 @@ def run_inertia_2d(thetas, out_steps, net, mo, wk, out, run, floats, ints, mu_bu
                 continue
             floats[T] = t + wait
             theta = theta_a + rate * (floats[T] - q)
+            if mo.times.size:
+                mo.times[1] = floats[T]
             start(net, mo, wk, floats, ints, j, theta)
             start_overloaded_all(net, mo, wk, floats, ints, theta)

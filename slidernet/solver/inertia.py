@@ -189,7 +189,8 @@ def new_motion(mu: np.ndarray, normal_load: np.ndarray) -> kin.Motion:
     top = int(np.argmax(mu))
     return kin.Motion(u=np.zeros(N), v=np.zeros(N), sig=np.zeros(N), mu=mu, lim=mu * normal_load,
                       moving=np.zeros(N, np.int64), start_t=np.zeros(N), start_clock=np.zeros(N),
-                      start_u=np.zeros(N), best=np.array([mu[top], top, 0.0]))
+                      start_u=np.zeros(N), best=np.array([mu[top], top, 0.0]), first=np.zeros((0, 2)),
+                      times=np.zeros(0))
 
 
 def new_log(records: int, rows: int) -> kin.Log:

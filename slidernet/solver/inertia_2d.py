@@ -68,7 +68,7 @@ def new_motion(scene: Scene, mu: np.ndarray, theta0: float) -> tuple[kern.Motion
         moving=np.zeros(n_nodes, np.int8), armed=np.zeros(n_nodes, np.int8), start_t=np.zeros(n_nodes),
         start_clock=np.zeros(n_nodes), start_u=np.zeros((n_nodes, 2)), path=np.zeros(n_nodes),
         mark=np.full(n_nodes, -1, np.int64), wmark=np.full(n_nodes, -1, np.int64),
-        best=np.array([mu[top], top, 0.0]))
+        best=np.array([mu[top], top, 0.0]), first=np.zeros((0, 2)), times=np.zeros(0))
     wk = kern.Work(
         M=np.zeros(n_nodes, np.int64), W=np.zeros(n_nodes, np.int64), mptr=np.zeros(n_nodes + 1, np.int64),
         mcol=np.zeros(nnz, np.int64), mblk=np.zeros(nnz, np.int64), wptr=np.zeros(n_nodes + 1, np.int64),

@@ -25,7 +25,9 @@ observables as they come:
 
 The state at a recorded time may hold moving nodes (a motion that crosses
 t_q); the network tilt test then tests that configuration as it stands,
-every node held where it is (docs/guides/inertia.md).
+every node held where it is (docs/guides/inertia.md), and so does the
+dynamic tilt test of ``[dynamics] tilt_rate``
+(:mod:`slidernet.solver.inertia_tilt`), each velocity set to zero.
 """
 
 from __future__ import annotations
@@ -85,6 +87,10 @@ def log2_bins(sizes: np.ndarray) -> np.ndarray:
     s = sizes[sizes > 0]
     return np.bincount(np.floor(np.log2(s)).astype(np.int64), minlength=kernels.N_AVALANCHE_BINS)
 
+
+# The motion's arrays a snapshot leaves out: the realization's thresholds (saved as its own), and the dynamic tilt
+# test's watch (empty in a run).
+_NOT_SAVED = ("mu", "first", "times")
 
 # What a backend's kernel call returns when a log is full: the digest empties it and the kernel goes on.
 _FULL = -1
@@ -360,7 +366,7 @@ class InertiaBackend(_Inertial):
         return {"q": i[kin.I_Q], "n": i[kin.I_N], "pos": i[kin.I_POS], "next_out": i[kin.I_REC]}
 
     def _state_arrays(self) -> dict[str, np.ndarray]:
-        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name != "mu"}
+        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name not in _NOT_SAVED}
         arrays.update({f"work/{name}": a for name, a in self.work._asdict().items()})
         return {**arrays, "kernel/istate": self.istate, "kernel/fstate": self.fstate}
 
@@ -420,6 +426,6 @@ class Inertia2DBackend(_Inertial):
         return {"q": i[k2d.Q], "n": i[k2d.N], "pos": i[k2d.POS], "next_out": i[k2d.NEXT_OUT]}
 
     def _state_arrays(self) -> dict[str, np.ndarray]:
-        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name != "mu"}
+        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name not in _NOT_SAVED}
         arrays.update({f"work/{name}": a for name, a in self.work._asdict().items()})
         return {**arrays, "kernel/floats": self.floats, "kernel/ints": self.ints}

@@ -42,6 +42,7 @@ _REBUILT = {
     "thetas": "redrawn by the constructor from the driver stream; its digest is checked",
     "_tilt_work": "scratch arrays of the network tilt test, reset by every test",
     "_shs_work": "scratch arrays of the slide-hold-slide pull, reset by every pull",
+    "_dynamic_loads": "the loads of the last dynamic tilt test ([dynamics] tilt_rate), reset by every test",
 }
 
 #: A stop request, polled where a kernel returns to refill a buffer: True asks the realization to stop there.
@@ -117,6 +118,7 @@ class Realization:
         self.out.update(_more_tilt_records(scene, T))
         self._tilted = 0  # recorded times whose network tilt test (and slide-hold-slide pull) is done
         self._tilt_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._dynamic_loads: dict[str, float] | None = None
         self._shs_work: tuple[kernels.Heaps, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.state = kernels.new_state()
         self.state["theta"] = self.thetas[0]
@@ -246,7 +248,9 @@ class Realization:
         rule, which is the appendix's for a 1D pair) and returns the total
         tangential load per unit normal load at that moment, f plus the mean
         f_ext along x. The state is left as it was; the draws come from the
-        realization's tilt stream.
+        realization's tilt stream. With ``[dynamics] tilt_rate`` the test is
+        the dynamic one, the load ramped at that rate under the equations of
+        motion (:mod:`slidernet.solver.inertia_tilt`).
 
         Parameters
         ----------
@@ -261,11 +265,19 @@ class Realization:
         from slidernet.kernels import tilt_net
 
         scene = self.scene
+        mu = self.mu.copy() if mu is None else mu
+        st = self.state
+        if scene.dynamics is not None and scene.dynamics.tilt_rate is not None:
+            from slidernet.solver.inertia_tilt import dynamic_tilt
+
+            f, self._dynamic_loads, p_mu = dynamic_tilt(self.backend, self, mu, scene.dynamics.tilt_rate)
+            if advance:
+                st["tilt_mu_pos"] = p_mu
+            return f
+        self._dynamic_loads = None
         o = scene.tilt_operators()
         N = scene.network.n_nodes
         (heaps, epoch, count, pos, loads), G = self._test_work("_tilt_work")
-        mu = self.mu.copy() if mu is None else mu
-        st = self.state
         pos[:] = 0
         pos[tilt_net.P_MU], pos[tilt_net.P_U] = st["tilt_mu_pos"][0], st["tilt_u_pos"][0]
         settings = scene.settings()
@@ -422,6 +434,8 @@ class Realization:
         from slidernet.kernels.tilt_net import STOP, STOP_CAP
 
         f = self.tilt_test(mu, advance=advance)
+        if self._dynamic_loads is not None:
+            return f, False, self._dynamic_loads
         _, _, _, pos, loads = self._tilt_work
         return (f, self.scene.counts_capped and pos[STOP] == STOP_CAP,
                 {name: float(loads[slot]) for name, slot in TILT_LOADS.items()})

@@ -189,6 +189,7 @@ class Dynamics(NamedTuple):
     tau_ratio: float  # tau_dyn / tau_th
     rtol: float  # 2D: relative error per step
     max_step: float  # 2D: longest step, tau_dyn
+    tilt_rate: float | None = None  # the dynamic tilt test's ramp, per tau_dyn; None: the quasi-static test
 
 
 @dataclass
@@ -371,7 +372,8 @@ class Scene:
             inject=tilt.inject if cfg.injected_tests() else None,
             shs_stiffness=cfg.shs_settings().stiffness if "mu_shs" in cfg.observables else None,
             operators=operators,
-            dynamics=None if dyn is None else Dynamics(float(dyn.tau_ratio), float(dyn.rtol), float(dyn.max_step)),
+            dynamics=None if dyn is None else Dynamics(float(dyn.tau_ratio), float(dyn.rtol), float(dyn.max_step),
+                                                 None if dyn.tilt_rate is None else float(dyn.tilt_rate)),
         )
         if scene.shs_stiffness is not None:
             scene.shs_operators()  # built now: pull springs that float64 cannot hold are refused before any work

@@ -116,7 +116,8 @@ def scene_fingerprint(scene: Scene) -> dict[str, Any]:
         # Only with the slide-hold-slide pull, likewise.
         **({} if scene.shs_stiffness is None else {"shs_stiffness": float(scene.shs_stiffness)}),
         # And the inertial solver's settings, with [dynamics].
-        **({} if scene.dynamics is None else {"dynamics": [float(x) for x in scene.dynamics]}),
+        # tilt_rate only where set: the fingerprints of the runs before it existed stay as they were.
+        **({} if scene.dynamics is None else {"dynamics": [float(x) for x in scene.dynamics if x is not None]}),
         "distribution": scene.distribution_name,
         "driver": scene.driver_name,
         "K": digest(*(getattr(ops, name) for name in _K_FIELDS if name in ops._fields)),
