@@ -63,7 +63,8 @@ from slidernet.config.tilt import InjectConfig, TiltConfig
 from slidernet.config.units import UnitsConfig
 
 __all__ = ["NETWORK_OBSERVABLES", "OBSERVABLES", "PAIR_TILT_ONLY", "SCHEDULER_REQUIREMENT", "Config",
-           "CreepConfig", "DynamicsConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig", "NetworkConfig",
+           "CreepConfig", "DynamicsConfig", "ExecutionConfig", "FiniteFloat", "FrictionConfig", "InjectConfig",
+           "NetworkConfig",
            "Observable", "PluginSpec", "PositiveFloat", "ShsConfig", "SolverConfig", "StrengtheningConfig",
            "TiltConfig", "UnitsConfig", "build_distribution", "build_network",
            "choose_kernel", "choose_tilt_at", "is_finite", "is_scheduler_address", "load_config", "read_toml"]
