@@ -155,3 +155,11 @@ def test_the_tilt_test_reads_the_dynamic_state_at_every_record():
     ratio = ds["tilt_break_ratio"].values
     assert np.isfinite(ratio).all() and (ratio > 0.5).all()
     assert ds.attrs["kernel"] == "inertia_2d"
+    assert "on the state of the equations of motion" in ds.attrs["mu_eff_estimator"]
+
+
+def test_the_result_names_the_dynamic_tilt_test_where_it_ran():
+    ds = slidernet.run(config("pair", steps=3, observables=["n", "mu_eff"], mu_eff_at="records",
+                              dynamics={"tau_ratio": 1e-3, "tilt_rate": 1e-3}), progress=False)
+    assert ds.attrs["mu_eff_estimator"].startswith(
+        "the dynamic tilt test (a uniform tilt ramped at 0.001 per tau_dyn")

@@ -97,8 +97,22 @@ def _attrs(cfg: Config, scene: Any, workers: int, scheduler: str | None,
     if scene.tilt_at is not None:
         # mu_eff_at = "auto" resolves per network: the result says which test it holds.
         attrs["mu_eff_at"] = scene.tilt_at
-        attrs["mu_eff_estimator"] = MU_EFF_ESTIMATORS[scene.tilt_at]
+        attrs["mu_eff_estimator"] = mu_eff_estimator(scene)
     return attrs
+
+
+def mu_eff_estimator(scene: Any) -> str:
+    """What a scene's mu_eff measures, in words: :data:`MU_EFF_ESTIMATORS`, said of the dynamic state with
+    ``[dynamics]``, or the dynamic tilt test's words with ``[dynamics] tilt_rate``."""
+    words = MU_EFF_ESTIMATORS[scene.tilt_at]
+    dyn = scene.dynamics
+    if dyn is None:
+        return words
+    if dyn.tilt_rate is None:
+        return words + ", on the state of the equations of motion ([dynamics]) as it stands"
+    return (f"the dynamic tilt test (a uniform tilt ramped at {dyn.tilt_rate!r} per tau_dyn under the equations "
+            "of motion, on a copy of the network, until it slides as a whole), made once per realization at "
+            "each recorded time t")
 
 
 def run(
