@@ -129,6 +129,8 @@ class _Inertial(ABC):
     # The kernel's own parts, one method each in the two backends.
     RUNAWAY: ClassVar[int]  # its return code of a runaway
     u: np.ndarray  # the displacements, Ntilde l0, shape (N,) or (N, 2)
+    motion: Any  # the kernel's Motion: per-node state, and the running mu_max ``best``
+    work: Any  # the kernel's Work: the scratch of a phase, saved with the motion
 
     @abstractmethod
     def _call(self, real: Any, thetas: np.ndarray, steps: int) -> int:
@@ -150,9 +152,9 @@ class _Inertial(ABC):
     def _time(self) -> float:
         """The kernel's time t, tau_th."""
 
-    @abstractmethod
     def _best(self) -> np.ndarray:
         """(mu_max, its holder, n_records), shape (3,)."""
+        return self.motion.best
 
     @abstractmethod
     def _runaway_node(self) -> int: ...
@@ -161,9 +163,15 @@ class _Inertial(ABC):
     def _scalars(self) -> dict[str, int]:
         """The kernel's step ``q``, ``n``, read position ``pos`` and next record ``next_out``."""
 
-    @abstractmethod
     def _state_arrays(self) -> dict[str, np.ndarray]:
         """Every array of the motion and the kernel's scalars, by name (``mu`` is the realization's own)."""
+        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name not in _NOT_SAVED}
+        arrays.update({f"work/{name}": a for name, a in self.work._asdict().items()})
+        return {**arrays, **self._kernel_scalars()}
+
+    @abstractmethod
+    def _kernel_scalars(self) -> dict[str, np.ndarray]:
+        """The kernel's integer and float scalars, by their snapshot names."""
 
     @abstractmethod
     def forces(self, real: Any) -> np.ndarray:
@@ -350,9 +358,6 @@ class InertiaBackend(_Inertial):
     def _time(self) -> float:
         return float(self.fstate[kin.F_T])
 
-    def _best(self) -> np.ndarray:
-        return self.motion.best
-
     def _runaway_node(self) -> int:
         return int(self.istate[kin.I_NODE])
 
@@ -365,10 +370,8 @@ class InertiaBackend(_Inertial):
         i = self.istate
         return {"q": i[kin.I_Q], "n": i[kin.I_N], "pos": i[kin.I_POS], "next_out": i[kin.I_REC]}
 
-    def _state_arrays(self) -> dict[str, np.ndarray]:
-        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name not in _NOT_SAVED}
-        arrays.update({f"work/{name}": a for name, a in self.work._asdict().items()})
-        return {**arrays, "kernel/istate": self.istate, "kernel/fstate": self.fstate}
+    def _kernel_scalars(self) -> dict[str, np.ndarray]:
+        return {"kernel/istate": self.istate, "kernel/fstate": self.fstate}
 
 
 class Inertia2DBackend(_Inertial):
@@ -411,9 +414,6 @@ class Inertia2DBackend(_Inertial):
     def _time(self) -> float:
         return float(self.floats[k2d.T])
 
-    def _best(self) -> np.ndarray:
-        return self.motion.best
-
     def _runaway_node(self) -> int:
         return int(self.ints[k2d.RUNAWAY_NODE])
 
@@ -425,7 +425,5 @@ class Inertia2DBackend(_Inertial):
         i = self.ints
         return {"q": i[k2d.Q], "n": i[k2d.N], "pos": i[k2d.POS], "next_out": i[k2d.NEXT_OUT]}
 
-    def _state_arrays(self) -> dict[str, np.ndarray]:
-        arrays = {f"motion/{name}": a for name, a in self.motion._asdict().items() if name not in _NOT_SAVED}
-        arrays.update({f"work/{name}": a for name, a in self.work._asdict().items()})
-        return {**arrays, "kernel/floats": self.floats, "kernel/ints": self.ints}
+    def _kernel_scalars(self) -> dict[str, np.ndarray]:
+        return {"kernel/floats": self.floats, "kernel/ints": self.ints}
