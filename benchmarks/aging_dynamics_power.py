@@ -31,7 +31,8 @@ Run from the repository root::
 
 Defaults: the pair (64 realizations), irregular 16 (4 geometries x 4
 realizations) and 64 (4 geometries x 1), T = 1000 tau_th, tau_dyn / tau_th in
-{1e-4, 1e-3, 1e-2, 1e-1} (64 sliders: 1e-4, 1e-1 and 1e-2, in that order). ``--quick`` runs the
+{1e-4, 1e-3, 1e-2, 1e-1} (64 sliders: 1e-4, 1e-1 and 1e-2, in that order; 256 sliders, 4
+geometries x 1, only when asked by ``--sizes 256``, with ``--taus`` to choose). ``--quick`` runs the
 pair and irregular 16 to 100 tau_th. The JSON (``aging_dynamics_power.json``)
 and a Markdown table are written when every point is done; each point's
 dataset is kept (``points/``), and a rerun reads the points already there.
@@ -110,11 +111,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--t-min", type=float, default=10.0)
+    parser.add_argument("--sizes", type=int, nargs="+", default=None,
+                        help="only these N (256: 4 geometries x 1 realization, not run by default)")
+    parser.add_argument("--taus", type=float, nargs="+", default=None, help="only these tau_dyn / tau_th")
     args = parser.parse_args(argv)
     taus = (1e-4, 1e-3, 1e-2, 1e-1)
     # (n, geometries, realizations per geometry, steps, taus)
     systems = ([(2, 1, 16, 100, taus), (16, 2, 2, 100, taus)] if args.quick else
-               [(2, 1, 64, 1000, taus), (16, 4, 4, 1000, taus), (64, 4, 1, 1000, (1e-4, 1e-1, 1e-2))])
+               [(2, 1, 64, 1000, taus), (16, 4, 4, 1000, taus), (64, 4, 1, 1000, (1e-4, 1e-1, 1e-2)),
+                (256, 4, 1, 1000, (1e-4, 1e-1, 1e-3, 1e-2))])
+    if args.sizes is None and not args.quick:
+        systems = systems[:3]  # 256 sliders cost 10-60 min of CPU per realization and tau: asked by --sizes
+    elif args.sizes is not None:
+        systems = [s for s in systems if s[0] in args.sizes]
+    if args.taus is not None:
+        systems = [(*s[:4], tuple(t for t in s[4] if t in args.taus)) for s in systems]
     args.out.mkdir(parents=True, exist_ok=True)
     start = time.monotonic()
     results: list[dict[str, Any]] = []
