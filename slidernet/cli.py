@@ -12,6 +12,7 @@
 ``slidernet plugins [--plugin FILE.py]``  lists the registered plugins, where they come from
 ``slidernet units --material steel --size 0.1 --delta-T 0.01``
                                           Ntilde, sigma_theta and tau_th of a physical setup
+``slidernet cache [clear]``               where the compiled kernels are kept, their size; or removes them
 
 ``python -m slidernet ...`` runs the same command.
 
@@ -128,6 +129,13 @@ def _parser() -> argparse.ArgumentParser:
 
     pg = sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
     _plugin_flag(pg)
+
+    c = sub.add_parser("cache", help="show where the compiled kernels are kept and their size; or clear them",
+                       description="slidernet compiles its kernels once and keeps them in a cache folder. "
+                                   "'slidernet cache' shows it; 'slidernet cache clear' removes slidernet's "
+                                   "files from it (the next run compiles again) and nothing else.")
+    c.add_argument("action", nargs="?", choices=("show", "clear"), default="show",
+                   help="show (default) or clear the cache")
 
     from slidernet.model.units import MATERIALS
 
@@ -347,6 +355,26 @@ def _cmd_units(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_cache(args: argparse.Namespace) -> int:
+    from slidernet.kernels import jit
+
+    if args.action == "clear":
+        count, size = jit.clear_cache()
+        print(f"removed {count} files ({_mib(size)}) of compiled kernels from {jit.cache_root()}")
+        return 0
+    files = jit.cache_files()
+    current = sum(1 for path in files if path.is_relative_to(jit.cache_dir()))
+    print(f"kernel cache: {jit.cache_root()}")
+    print(f"  {len(files)} files, {_mib(sum(path.stat().st_size for path in files))}; {current} of them for "
+          f"these sources ({jit.cache_dir()})")
+    print("  'slidernet cache clear' removes them; set NUMBA_CACHE_DIR to move the cache.")
+    return 0
+
+
+def _mib(size: int) -> str:
+    return f"{size / 2**20:.1f} MiB"
+
+
 #: The exit status of the command, one rule for every subcommand (docs/getting-started.md says it too).
 EXIT_OK = 0
 #: A bug of slidernet's: an error nobody foresaw. Python's traceback is shown, to be reported.
@@ -376,7 +404,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         with _one_line_warnings():
             args = _parser().parse_args(argv)
             commands = {"run": _cmd_run, "plot": _cmd_plot, "paper": _cmd_paper, "bench": _cmd_bench,
-                        "sweep": _cmd_sweep, "plugins": _cmd_plugins, "units": _cmd_units}
+                        "sweep": _cmd_sweep, "plugins": _cmd_plugins, "units": _cmd_units,
+                        "cache": _cmd_cache}
             started = True
             status = commands[args.command](args)
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit
