@@ -10,7 +10,7 @@
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
 ``slidernet plugins [--plugin FILE.py]``  lists the registered plugins, where they come from
-``slidernet units --material steel --size 0.1 --delta-T 0.01``
+``slidernet units --material steel --size 10cm --delta-T 10mK``
                                           Ntilde, sigma_theta and tau_th of a physical setup
 ``slidernet cache [clear]``               where the compiled kernels are kept, their size; or removes them
 
@@ -145,14 +145,16 @@ def _parser() -> argparse.ArgumentParser:
                     "(Geminard & Bertin 2010, section V), with a TOML snippet for a configuration.",
     )
     u.add_argument("--material", help=f"a preset ({', '.join(sorted(MATERIALS))}); explicit values override it")
-    u.add_argument("--size", type=float, required=True, help="slider size l0, m")
-    u.add_argument("--delta-T", dest="delta_T", type=float, help="standard deviation of the temperature, K")
-    u.add_argument("--rho", type=float, help="density, kg/m^3")
-    u.add_argument("--Y", type=float, help="Young's modulus, Pa")
-    u.add_argument("--alpha", type=float, help="linear thermal expansion coefficient, 1/K")
-    u.add_argument("--conductivity", type=float, help="thermal conductivity, W/(m K)")
-    u.add_argument("--heat-capacity", dest="heat_capacity", type=float, help="specific heat capacity, J/(kg K)")
-    u.add_argument("--g", type=float, default=9.81, help="gravity, m/s^2 (default 9.81)")
+    # A quantity with its unit, read by pint in _cmd_units (slidernet.model.units.QUANTITIES): a bare number
+    # is refused, since "--size 10" meant as cm gave l0 = 10 m.
+    u.add_argument("--size", required=True, help="slider size l0 with its unit, e.g. 10cm")
+    u.add_argument("--delta-T", dest="delta_T", help="standard deviation of the temperature, e.g. 0.01K or 10mK")
+    u.add_argument("--rho", help="density, e.g. 7800kg/m^3 or 7.8g/cm^3")
+    u.add_argument("--Y", help="Young's modulus, e.g. 200GPa")
+    u.add_argument("--alpha", help="linear thermal expansion coefficient, e.g. 12e-6/K or 12ppm/K")
+    u.add_argument("--conductivity", help="thermal conductivity, e.g. 50W/m/K")
+    u.add_argument("--heat-capacity", dest="heat_capacity", help="specific heat capacity, e.g. 450J/kg/K")
+    u.add_argument("--g", help="gravity, e.g. 9.81m/s^2 (default 9.81m/s^2)")
     return p
 
 
@@ -343,10 +345,11 @@ def _summary(factory: object) -> str:
 
 
 def _cmd_units(args: argparse.Namespace) -> int:
-    from slidernet.model.units import setup
+    from slidernet.model.units import QUANTITIES, read_quantity, setup
 
-    values = {k: getattr(args, k) for k in ("rho", "Y", "alpha", "conductivity", "heat_capacity")}
-    result = setup(args.material, size=args.size, delta_T=args.delta_T, g=args.g, **values)
+    values = {name: read_quantity(getattr(args, name), name, "--" + name.replace("_", "-"))
+              for name in QUANTITIES if getattr(args, name) is not None}
+    result = setup(args.material, **values)
     print(result.summary())
     print("\n# In a configuration (exact values):")
     print(result.toml())
