@@ -376,7 +376,8 @@ class Series:
     are skipped. The times must be strictly increasing but need not be evenly
     spaced: T is interpolated linearly between samples, which is also how
     the solver treats theta between two t_q. The file is read, and checked,
-    once, in the constructor; the ``rng`` is not used.
+    once, in the constructor; the ``rng`` is not used. The format, with an
+    example: ``docs/guides/file-formats.md``.
 
     Parameters
     ----------

@@ -26,6 +26,8 @@ class Empirical(Distribution):
     value: E[max of m] = sum_k v_(k) [(k/K)^m - ((k-1)/K)^m] over the K
     sorted values v_(k) above mu_d.
 
+    The file's format, with examples: ``docs/guides/file-formats.md``.
+
     Parameters
     ----------
     path : str or path-like
