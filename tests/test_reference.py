@@ -59,7 +59,7 @@ def test_every_table_has_its_section_and_the_guide_links_it():
     ("friction.overshoot", "| `friction.overshoot` | float | *unset* | 1 | in [0, 1] |"),
     ("execution.stop_timeout", "| `execution.stop_timeout` | float | 10 | s | > 0, inf allowed |"),
     ("network.incline", "| `network.incline` | float | *unset* | degree | in [0, 90) |"),
-    ("seed", "| `seed` | int | *unset* | — | >= 0, < 2^128 |"),
+    ("seed", "| `seed` | int | *unset* | — | >= 0, \\< 2^128 |"),
     ("solver.max_avalanche", "| `solver.max_avalanche` | int | 1e8 | slips | >= 1 |"),
     ("driver.tau_c", "| `driver.tau_c` | float | *required* | tau_th | Correlation time, in units of tau_th; > 0. "
                      "|"),

@@ -166,7 +166,9 @@ def _default(field: FieldInfo) -> str:
 
 
 def _cell(text: str) -> str:
-    return " ".join(text.split()).replace("|", "\\|")
+    """One table cell: one line, its bars escaped, and its "<" outside code (``<k>`` would read as an HTML tag)."""
+    parts = " ".join(text.split()).replace("|", "\\|").split("`")
+    return "`".join(part if i % 2 else part.replace("<", "\\<") for i, part in enumerate(parts))
 
 
 _COLUMNS = "| Key | Type | Default | Unit | Constraint | Description |\n|---|---|---|---|---|---|\n"
