@@ -69,8 +69,8 @@ def test_an_output_pipe_closed_before_the_command_writes_exits_141(tmp_path):
     read, write = os.pipe()
     os.close(read)  # every write to the pipe now fails (EPIPE): no race with a reader
     try:
-        proc = subprocess.run([sys.executable, "-m", "slidernet", "units", "--material", "steel", "--size", "0.1m"],
-                              stdout=write, stderr=subprocess.PIPE, text=True, timeout=120)
+        proc = subprocess.run([sys.executable, "-m", "slidernet", "units", "--material", "steel",
+                               "--size", "0.1m"], stdout=write, stderr=subprocess.PIPE, text=True, timeout=120)
     finally:
         os.close(write)
     assert proc.returncode == 141, proc.stderr

@@ -213,7 +213,7 @@ def _parameters(factory: Any) -> dict[str, tuple[str, str]]:
     for head, body in re.findall(r"^(\S[^\n]*)\n((?:[ \t]+[^\n]*\n?|\n(?=[ \t]))*)", section.group(1), re.M):
         names, _, kind = head.partition(" : ")
         for name in names.split(","):
-            found[name.strip()] = (kind.replace(", optional", "").strip(), _cell(body).replace("``", "`"))
+            found[name.strip()] = (kind.replace(", optional", "").strip(), _cell(body.replace("``", "`")))
     return found
 
 
