@@ -10,8 +10,9 @@
 ``slidernet bench speed-error [--quick] --out DIR``
                                           speed against error of the methods (DIR/speed_error.csv, .png)
 ``slidernet plugins [--plugin FILE.py]``  lists the registered plugins, where they come from
-``slidernet units --material steel --size 0.1 --delta-T 0.01``
+``slidernet units --material steel --size 10cm --delta-T 10mK``
                                           Ntilde, sigma_theta and tau_th of a physical setup
+``slidernet cache [clear]``               where the compiled kernels are kept, their size; or removes them
 
 ``python -m slidernet ...`` runs the same command.
 
@@ -129,6 +130,13 @@ def _parser() -> argparse.ArgumentParser:
     pg = sub.add_parser("plugins", help="list the registered distributions and drivers, and where they come from")
     _plugin_flag(pg)
 
+    c = sub.add_parser("cache", help="show where the compiled kernels are kept and their size; or clear them",
+                       description="slidernet compiles its kernels once and keeps them in a cache folder. "
+                                   "'slidernet cache' shows it; 'slidernet cache clear' removes slidernet's "
+                                   "files from it (the next run compiles again) and nothing else.")
+    c.add_argument("action", nargs="?", choices=("show", "clear"), default="show",
+                   help="show (default) or clear the cache")
+
     from slidernet.model.units import MATERIALS
 
     u = sub.add_parser(
@@ -137,14 +145,16 @@ def _parser() -> argparse.ArgumentParser:
                     "(Geminard & Bertin 2010, section V), with a TOML snippet for a configuration.",
     )
     u.add_argument("--material", help=f"a preset ({', '.join(sorted(MATERIALS))}); explicit values override it")
-    u.add_argument("--size", type=float, required=True, help="slider size l0, m")
-    u.add_argument("--delta-T", dest="delta_T", type=float, help="standard deviation of the temperature, K")
-    u.add_argument("--rho", type=float, help="density, kg/m^3")
-    u.add_argument("--Y", type=float, help="Young's modulus, Pa")
-    u.add_argument("--alpha", type=float, help="linear thermal expansion coefficient, 1/K")
-    u.add_argument("--conductivity", type=float, help="thermal conductivity, W/(m K)")
-    u.add_argument("--heat-capacity", dest="heat_capacity", type=float, help="specific heat capacity, J/(kg K)")
-    u.add_argument("--g", type=float, default=9.81, help="gravity, m/s^2 (default 9.81)")
+    # A quantity with its unit, read by pint in _cmd_units (slidernet.model.units.QUANTITIES): a bare number
+    # is refused, since "--size 10" meant as cm gave l0 = 10 m.
+    u.add_argument("--size", required=True, help="slider size l0 with its unit, e.g. 10cm")
+    u.add_argument("--delta-T", dest="delta_T", help="standard deviation of the temperature, e.g. 0.01K or 10mK")
+    u.add_argument("--rho", help="density, e.g. 7800kg/m^3 or 7.8g/cm^3")
+    u.add_argument("--Y", help="Young's modulus, e.g. 200GPa")
+    u.add_argument("--alpha", help="linear thermal expansion coefficient, e.g. 12e-6/K or 12ppm/K")
+    u.add_argument("--conductivity", help="thermal conductivity, e.g. 50W/m/K")
+    u.add_argument("--heat-capacity", dest="heat_capacity", help="specific heat capacity, e.g. 450J/kg/K")
+    u.add_argument("--g", help="gravity, e.g. 9.81m/s^2 (default 9.81m/s^2)")
     return p
 
 
@@ -335,16 +345,37 @@ def _summary(factory: object) -> str:
 
 
 def _cmd_units(args: argparse.Namespace) -> int:
-    from slidernet.model.units import setup
+    from slidernet.model.units import QUANTITIES, read_quantity, setup
 
-    values = {k: getattr(args, k) for k in ("rho", "Y", "alpha", "conductivity", "heat_capacity")}
-    result = setup(args.material, size=args.size, delta_T=args.delta_T, g=args.g, **values)
+    values = {name: read_quantity(getattr(args, name), name, "--" + name.replace("_", "-"))
+              for name in QUANTITIES if getattr(args, name) is not None}
+    result = setup(args.material, **values)
     print(result.summary())
     print("\n# In a configuration (exact values):")
     print(result.toml())
     print("\n# or let slidernet compute them:")
     print(result.units_toml())
     return 0
+
+
+def _cmd_cache(args: argparse.Namespace) -> int:
+    from slidernet.kernels import jit
+
+    if args.action == "clear":
+        count, size = jit.clear_cache()
+        print(f"removed {count} files ({_mib(size)}) of compiled kernels from {jit.cache_root()}")
+        return 0
+    files = jit.cache_files()
+    current = sum(1 for path in files if path.is_relative_to(jit.cache_dir()))
+    print(f"kernel cache: {jit.cache_root()}")
+    print(f"  {len(files)} files, {_mib(sum(path.stat().st_size for path in files))}; {current} of them for "
+          f"these sources ({jit.cache_dir()})")
+    print("  'slidernet cache clear' removes them; set NUMBA_CACHE_DIR to move the cache.")
+    return 0
+
+
+def _mib(size: int) -> str:
+    return f"{size / 2**20:.1f} MiB"
 
 
 #: The exit status of the command, one rule for every subcommand (docs/getting-started.md says it too).
@@ -376,7 +407,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         with _one_line_warnings():
             args = _parser().parse_args(argv)
             commands = {"run": _cmd_run, "plot": _cmd_plot, "paper": _cmd_paper, "bench": _cmd_bench,
-                        "sweep": _cmd_sweep, "plugins": _cmd_plugins, "units": _cmd_units}
+                        "sweep": _cmd_sweep, "plugins": _cmd_plugins, "units": _cmd_units,
+                        "cache": _cmd_cache}
             started = True
             status = commands[args.command](args)
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below, not at exit

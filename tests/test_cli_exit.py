@@ -44,7 +44,7 @@ CTRL_C_AT_IMPORT = textwrap.dedent("""\
 
 
 @pytest.mark.parametrize(("module", "command", "line"), [
-    ("slidernet.model.units", ["units", "--material", "steel", "--size", "0.1"],
+    ("slidernet.model.units", ["units", "--material", "steel", "--size", "0.1m"],
      "slidernet: {what} while starting; nothing was done."),
     ("xarray", ["run", "CONFIG", "--out", "OUT", "--no-progress"],
      "slidernet: {what}; files already written are complete, nothing else was saved."),
@@ -69,8 +69,8 @@ def test_an_output_pipe_closed_before_the_command_writes_exits_141(tmp_path):
     read, write = os.pipe()
     os.close(read)  # every write to the pipe now fails (EPIPE): no race with a reader
     try:
-        proc = subprocess.run([sys.executable, "-m", "slidernet", "units", "--material", "steel", "--size", "0.1"],
-                              stdout=write, stderr=subprocess.PIPE, text=True, timeout=120)
+        proc = subprocess.run([sys.executable, "-m", "slidernet", "units", "--material", "steel",
+                               "--size", "0.1m"], stdout=write, stderr=subprocess.PIPE, text=True, timeout=120)
     finally:
         os.close(write)
     assert proc.returncode == 141, proc.stderr
@@ -98,7 +98,7 @@ def test_a_file_or_memory_error_is_one_line_and_exit_2(monkeypatch, capsys, erro
         raise error
 
     monkeypatch.setattr(cli, "_cmd_units", fail)
-    assert _status_and_lines(capsys, ["units", "--size", "0.1"]) == (2, [line])
+    assert _status_and_lines(capsys, ["units", "--size", "0.1m"]) == (2, [line])
 
 
 def test_a_folder_given_as_the_configuration_exits_2(tmp_path, capsys):
@@ -112,7 +112,7 @@ def test_a_bug_shows_its_traceback_asks_to_report_it_and_exits_1(monkeypatch, ca
         raise ZeroDivisionError("a bug")
 
     monkeypatch.setattr(cli, "_cmd_units", fail)
-    status, lines = _status_and_lines(capsys, ["units", "--size", "0.1"])
+    status, lines = _status_and_lines(capsys, ["units", "--size", "0.1m"])
     assert status == 1
     assert lines[0] == "Traceback (most recent call last):" and "ZeroDivisionError: a bug" in lines
     assert lines[-1] == ("slidernet: internal error: this is a bug of slidernet; please report it with the "
@@ -127,7 +127,7 @@ def test_a_warning_of_slidernet_is_one_line(monkeypatch, capsys):
         return 0
 
     monkeypatch.setattr(cli, "_cmd_units", warn)
-    assert _status_and_lines(capsys, ["units", "--size", "0.1"]) == (
+    assert _status_and_lines(capsys, ["units", "--size", "0.1m"]) == (
         0, ["slidernet: warning: This run would take about 3 hours."])
 
 

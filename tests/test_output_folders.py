@@ -163,7 +163,7 @@ def test_bad_output_paths_are_one_line(tmp_path, config, capsys, kind):
 
 
 def test_a_closed_pipe_is_one_line():
-    proc = subprocess.run(f"{sys.executable} -m slidernet.cli units --material steel --size 0.1 --delta-T 0.01 "
+    proc = subprocess.run(f"{sys.executable} -m slidernet.cli units --material steel --size 10cm --delta-T 10mK "
                           "| head -c 1 > /dev/null", shell=True, capture_output=True, text=True,
                           executable="/bin/bash")
     # The pipe is closed after one byte; slidernet may or may not have been writing then.

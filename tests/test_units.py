@@ -316,7 +316,7 @@ def test_configs_without_units_are_unchanged():
 
 
 def test_cli_units_with_a_preset(capsys):
-    assert main(["units", "--material", "steel", "--size", "0.1", "--delta-T", "1"]) == 0
+    assert main(["units", "--material", "steel", "--size", "10cm", "--delta-T", "1K"]) == 0
     out = capsys.readouterr().out
     for text in ("Ntilde              3.85e-08", "sigma_theta         1.2e-05", "sigma_theta/Ntilde  312",
                  "tau_th              769 s"):
@@ -330,8 +330,8 @@ def test_cli_units_with_a_preset(capsys):
 
 
 def test_cli_units_with_explicit_values(capsys):
-    argv = ["units", "--rho", "1000", "--Y", "1e11", "--alpha", "1e-5", "--conductivity", "1",
-            "--heat-capacity", "1000", "--size", "0.01", "--delta-T", "0.001", "--g", "10"]
+    argv = ["units", "--rho", "1g/cm^3", "--Y", "100GPa", "--alpha", "10ppm/K", "--conductivity", "1W/m/K",
+            "--heat-capacity", "1000 J/(kg K)", "--size", "1cm", "--delta-T", "1mK", "--g", "10m/s^2"]
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "Ntilde              1e-09" in out and "sigma_theta         1e-08" in out
@@ -340,15 +340,44 @@ def test_cli_units_with_explicit_values(capsys):
 
 @pytest.mark.parametrize(
     ("argv", "message"),
-    [(["--rho", "1000"], "Give a material or explicit values of 'Y' (units)."),
-     (["--material", "steel", "--Y", "-1"], "The 'Y' parameter of units must be > 0. Got -1.0 instead."),
+    [(["--rho", "1000kg/m^3"], "Give a material or explicit values of 'Y' (units)."),
+     (["--material", "steel", "--Y=-1Pa"], "The 'Y' parameter of units must be > 0. Got -1.0 instead."),
      (["--material", "wood"], "Unknown material 'wood'.")],
     ids=["no-Y", "negative-Y", "unknown"],
 )
 def test_cli_units_errors(argv, message, capsys):
-    assert main(["units", "--size", "0.1", *argv]) == 2
+    assert main(["units", "--size", "0.1m", *argv]) == 2
     err = capsys.readouterr().err
     assert err.startswith("slidernet: error: ") and message in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [(["--size", "10"], "The '--size' option must be a length with its unit, such as --size 10cm or --size 0.1m: "
+                        "a bare number is ambiguous. Got '10' instead."),
+     (["--size", "10cm", "--delta-T", "300"], "The '--delta-T' option must be a temperature difference with its "
+                                              "unit, such as --delta-T 0.01K or --delta-T 10mK: a bare number"),
+     (["--size", "10cm", "--Y", "200"], "The '--Y' option must be a Young's modulus with its unit"),
+     (["--size", "3K"], "its unit, K, is not that of a length. Got '3K' instead."),
+     (["--size", "10 cn"], "pint cannot read it as a number and a unit. Got '10 cn' instead."),
+     (["--size", "10cm", "--delta-T", "3degC"], "(a temperature difference in degrees Celsius is written "
+                                                "delta_degC)")],
+    ids=["bare-size", "bare-delta-T", "bare-Y", "size-in-kelvin", "unknown-unit", "celsius"],
+)
+def test_cli_units_refuses_a_quantity_without_its_unit(argv, message, capsys):
+    """Issue 46: ``--size 10`` meant as cm gave l0 = 10 m, and ``--delta-T 300`` was taken as 300 K."""
+    assert main(["units", "--material", "steel", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("slidernet: error: ") and err.count("\n") == 1 and message in err
+
+
+@pytest.mark.parametrize(("text", "param", "value"),
+                         [("10cm", "size", 0.1), ("4in", "size", 0.1016), ("3 delta_degC", "delta_T", 3.0),
+                          ("7.8g/cm^3", "rho", 7800.0), ("200GPa", "Y", 2e11), ("12ppm/K", "alpha", 1.2e-5),
+                          ("50 W/(m K)", "conductivity", 50.0), ("9.81m/s^2", "g", 9.81)],
+                         ids=lambda v: str(v))
+def test_read_quantity_converts_to_si(text, param, value):
+    assert units.read_quantity(text, param) == pytest.approx(value, rel=1e-12)
 
 
 def test_units_table_as_a_model_instance():

@@ -91,6 +91,14 @@ NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False), BeforeVali
 PositiveReal = Annotated[float, Field(gt=0), BeforeValidator(_real)]
 
 
+def unit(symbol: str, constraint: str | None = None) -> dict[str, str]:
+    """A field's unit, for its ``json_schema_extra``, where the reference (:mod:`slidernet.config.reference`)
+    and the JSON schema read it: ``"1"`` for a dimensionless number. Every numeric field has one
+    (``tests/test_reference.py``). ``constraint``: what a validator of the field checks beyond its bounds, in
+    words (``"< steps"``)."""
+    return {"unit": symbol} if constraint is None else {"unit": symbol, "constraint": constraint}
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
     # Keys left out of a dump when None: a configuration that does not use a key added later dumps as it

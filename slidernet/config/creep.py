@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from slidernet.config.base import NonNegativeFloat, PositiveFloat, _Strict
+from slidernet.config.base import NonNegativeFloat, PositiveFloat, _Strict, unit
 
 
 class CreepConfig(_Strict):
@@ -32,7 +32,9 @@ class CreepConfig(_Strict):
     transient: NonNegativeFloat = Field(
         0.0, description="Time, in tau_th, before which x_G is left out of the reptation velocity: v_creep "
                          "is measured from the first cycle that starts at or after it (periodic driver) or "
-                         "from it (otherwise) to the end; >= 0 and < steps.")
+                         "from it (otherwise) to the end; >= 0 and < steps.",
+        json_schema_extra=unit("tau_th", "< steps"))
     event_fraction: PositiveFloat = Field(
         0.25, description="A creep event is an avalanche whose advance of x_G along +x exceeds event_fraction "
-                          "times the reference slip ell = 2 (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>; > 0.")
+                          "times the reference slip ell = 2 (<mu_s> - mu_d) <N_i> Ntilde l0 / <k>; > 0.",
+        json_schema_extra=unit("ell"))

@@ -19,7 +19,7 @@ from typing import Annotated
 
 from pydantic import Field
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import PositiveFloat, _Strict, unit
 
 
 class DynamicsConfig(_Strict):
@@ -32,14 +32,16 @@ class DynamicsConfig(_Strict):
     """
 
     tau_ratio: PositiveFloat = Field(
-        description="tau_dyn / tau_th, > 0: a slip's time scale sqrt(m / k) over the thermal step's.")
+        description="tau_dyn / tau_th, > 0: a slip's time scale sqrt(m / k) over the thermal step's.",
+        json_schema_extra=unit("1"))
     rtol: Annotated[PositiveFloat, Field(ge=1e-14, le=1e-3)] = Field(
         1e-10, description="2D only: the integration's relative error per step in u and v (absolute: 1e-2 rtol, "
-                           "in Ntilde l0).")
+                           "in Ntilde l0).", json_schema_extra=unit("1"))
     max_step: PositiveFloat = Field(
         0.1, description="2D only: the longest integration step, in tau_dyn; a stuck neighbour whose force rises "
-                         "above its threshold and falls back within one step is not seen.")
+                         "above its threshold and falls back within one step is not seen.",
+        json_schema_extra=unit("tau_dyn"))
     tilt_rate: PositiveFloat | None = Field(
         None, description="The dynamic tilt test's ramp: the load per unit normal load rises at this rate per "
                           "tau_dyn (units of mu), under the equations of motion. Absent: the quasi-static network "
-                          "tilt test of the state at each recorded time.")
+                          "tilt test of the state at each recorded time.", json_schema_extra=unit("1/tau_dyn"))

@@ -11,7 +11,7 @@ from typing import Annotated
 
 from pydantic import Field, field_validator
 
-from slidernet.config.base import Integer, PositiveReal, _Strict
+from slidernet.config.base import Integer, PositiveReal, _Strict, unit
 
 
 class ExecutionConfig(_Strict):
@@ -32,19 +32,22 @@ class ExecutionConfig(_Strict):
     """
 
     workers: Annotated[Integer, Field(ge=1)] | None = Field(
-        None, description="Local processes that run the realizations (None: every core this process may use).")
+        None, description="Local processes that run the realizations (None: every core this process may use).",
+        json_schema_extra=unit("1"))
     scheduler: str | None = Field(
         None, description="Address of a Dask scheduler, 'tcp://host:port' (any address a Dask Client can reach "
                           "a remote scheduler at: scheduler_address_problem); when given, the realizations run "
                           "on that cluster and 'workers' is ignored.")
     checkpoint_every: PositiveReal = Field(
-        60.0, description="Seconds between two saves of the work of a run that has an output directory.")
+        60.0, description="Seconds between two saves of the work of a run that has an output directory.",
+        json_schema_extra=unit("s"))
     scheduler_timeout: PositiveReal = Field(
-        10.0, description="Seconds to wait for the Dask scheduler to answer before giving up.")
+        10.0, description="Seconds to wait for the Dask scheduler to answer before giving up.",
+        json_schema_extra=unit("s"))
     stop_timeout: PositiveReal = Field(
         10.0, description="Seconds the running realizations get, after Ctrl-C or SIGTERM (or an error), to reach "
                           "a clean point and save; those still running then (a plugin that never returns) are "
-                          "ended at their last save.")
+                          "ended at their last save.", json_schema_extra=unit("s"))
 
     @field_validator("scheduler")
     @classmethod

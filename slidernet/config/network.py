@@ -14,7 +14,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, Seed, _Strict
+from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, Seed, _Strict, unit
 from slidernet.errors import SlidernetError
 from slidernet.model.builders import KIND_DIMS, build
 from slidernet.model.network import Network, pair_tilt_applies
@@ -52,11 +52,13 @@ class NetworkConfig(_Strict):
         "two_slider", description="The network's geometry; each kind takes its own size keys (above).")
     Ntilde: PositiveFloat = Field(
         description="Ntilde = N / (k l0), the one dimensionless number of the model (docs/model.md section 1); "
-                    "may come from [units] instead.")
+                    "may come from [units] instead.", json_schema_extra=unit("1"))
     n: Annotated[Integer, Field(ge=2)] | None = Field(
-        None, description="Number of sliders: kinds 'chain' and 'irregular' (and 2 for 'two_slider').")
+        None, description="Number of sliders: kinds 'chain' and 'irregular' (and 2 for 'two_slider').",
+        json_schema_extra=unit("1"))
     shape: tuple[Annotated[Integer, Field(ge=1)], Annotated[Integer, Field(ge=1)]] | None = Field(
-        None, description="[rows, cols] of a 'square' or 'triangular' lattice (at least 2 sliders).")
+        None, description="[rows, cols] of a 'square' or 'triangular' lattice (at least 2 sliders).",
+        json_schema_extra=unit("1"))
     path: str | None = Field(
         None, description="A GraphML or edge-list file of kind 'graph'; relative to the TOML file that names it.")
     seed: Seed | None = Field(
@@ -64,19 +66,19 @@ class NetworkConfig(_Strict):
                           "same for every realization, whatever the run's seed.")
     k: PositiveFloat | None = Field(
         None, description="Stiffness of every spring, in units of k0 = N / (Ntilde l0), the paper's spring "
-                          "(None: 1); k / Ntilde in N/l0 (docs/model.md section 2).")
+                          "(None: 1); k / Ntilde in N/l0 (docs/model.md section 2).", json_schema_extra=unit("k0"))
     kappa: FiniteFloat | None = Field(
         None, description="Dilation coefficient of every spring: its rest length is its length at theta = 0 "
-                          "times (1 + kappa theta) (None: 1).")
+                          "times (1 + kappa theta) (None: 1).", json_schema_extra=unit("1"))
     normal_load: PositiveFloat | None = Field(
-        None, description="Normal load of every slider, in units of N (None: 1).")
+        None, description="Normal load of every slider, in units of N (None: 1).", json_schema_extra=unit("N"))
     f_ext: FiniteFloat | tuple[FiniteFloat, FiniteFloat] | None = Field(
         None, description="Constant external tangential force on every slider, in units of N: a number "
-                          "along x, or [fx, fy] (2D networks only); None: 0.")
+                          "along x, or [fx, fy] (2D networks only); None: 0.", json_schema_extra=unit("N"))
     incline: FiniteFloat | None = Field(
         None, description="Angle of the substrate in degrees, in [0, 90), downhill along +x: every slider "
                           "feels N_i tan(incline) along x as its f_ext (docs/model.md, 'External force'); "
-                          "not with f_ext. None: horizontal.")
+                          "not with f_ext. None: horizontal.", json_schema_extra=unit("degree", "in [0, 90)"))
 
     @field_validator("incline")
     @classmethod

@@ -17,7 +17,7 @@ from typing import Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict, unit
 from slidernet.errors import ConfigError
 from slidernet.kernels.strength import strengthening
 from slidernet.plugins import registry
@@ -54,11 +54,14 @@ class StrengtheningConfig(_Strict):
     law: Literal["log", "power"] = Field(
         "log", description="'log': beta ln(1 + a/tau_c); 'power': beta ((1 + a/tau_c)^exponent - 1).")
     beta: Annotated[FiniteFloat, Field(ge=0)] = Field(
-        description="beta >= 0: the strengthening's amplitude, in units of mu_s (0: the option has no effect).")
+        description="beta >= 0: the strengthening's amplitude, in units of mu_s (0: the option has no effect).",
+        json_schema_extra=unit("1"))
     tau_c: PositiveFloat = Field(
-        description="tau_c > 0: the age at which strengthening sets in, in tau_th.")
+        description="tau_c > 0: the age at which strengthening sets in, in tau_th.",
+        json_schema_extra=unit("tau_th"))
     exponent: Annotated[FiniteFloat, Field(gt=0, le=1)] | None = Field(
-        None, description="The power law's exponent p in (0, 1] (law = 'power' only).")
+        None, description="The power law's exponent p in (0, 1] (law = 'power' only).",
+        json_schema_extra=unit("1"))
 
     @model_validator(mode="after")
     def _exponent_with_power_law(self) -> StrengtheningConfig:
@@ -112,13 +115,15 @@ class FrictionConfig(_Strict):
 
     _omit_if_none: ClassVar[tuple[str, ...]] = ("overshoot", "strengthening")
 
-    mu_d: PositiveFloat = Field(description="Dynamic friction coefficient mu_d (dimensionless).")
+    mu_d: PositiveFloat = Field(description="Dynamic friction coefficient mu_d (dimensionless).",
+                                json_schema_extra=unit("1"))
     static: PluginSpec = Field(
         description="The distribution p(mu_s) of the static thresholds: a registered name and its "
                     "parameters; conditioned on mu_s > mu_d.")
     overshoot: Annotated[FiniteFloat, Field(ge=0, le=1)] | None = Field(
         None, description="e in [0, 1]: a slip moves a node by (1 + e)(F - mu_d N)/K_ii, F the force's "
-                          "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).")
+                          "magnitude (None: 1, the paper's undamped slip; 0: the slip stops at mu_d N).",
+        json_schema_extra=unit("1"))
     strengthening: StrengtheningConfig | None = Field(
         None, description="Contact strengthening, the [friction.strengthening] table (None: thresholds do not "
                           "age).")

@@ -13,7 +13,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from slidernet.config.base import Integer, Seed, _Strict
+from slidernet.config.base import Integer, Seed, _Strict, unit
 from slidernet.config.creep import CreepConfig
 from slidernet.config.dynamics import DynamicsConfig
 from slidernet.config.execution import ExecutionConfig
@@ -66,14 +66,16 @@ class Config(_Strict):
     seed: Seed | None = Field(
         None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
                           "SeedSequence(seed) (None: fresh OS entropy, stored in the result).")
-    realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.")
+    realizations: Annotated[Integer, Field(ge=1)] = Field(1, description="Number of independent realizations R.",
+                                                          json_schema_extra=unit("1"))
     steps: Annotated[Integer, Field(ge=1)] = Field(
-        description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).")
+        description="Duration of a realization, in thermal steps of tau_th (theta is redrawn at each).",
+        json_schema_extra=unit("tau_th"))
     record: Literal["log", "all"] | list[Annotated[Integer, Field(ge=0)]] = Field(
         "log", description="Recorded times, in tau_th: 'log'-spaced, 'all', or a list of steps; 0 and 'steps' "
-                           "always included.")
+                           "always included.", json_schema_extra=unit("tau_th"))
     log_points_per_decade: Annotated[Integer, Field(ge=1, le=1000)] = Field(
-        20, description="Recorded times per decade of t with record = 'log'.")
+        20, description="Recorded times per decade of t with record = 'log'.", json_schema_extra=unit("1"))
     observables: list[Observable] = Field(
         default_factory=lambda: ["n", "mu_max", "x_G"],
         description="Variables to record (default ['n', 'mu_max', 'x_G']; docs/model.md section 3); the "

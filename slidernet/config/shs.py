@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import PositiveFloat, _Strict, unit
 
 
 class ShsConfig(_Strict):
@@ -30,4 +30,4 @@ class ShsConfig(_Strict):
 
     stiffness: PositiveFloat = Field(
         1.0, description="gamma: each node's pull spring, gamma N_i <k>, relative to the network's mean spring "
-                         "stiffness <k> per unit normal load N_i; > 0.")
+                         "stiffness <k> per unit normal load N_i; > 0.", json_schema_extra=unit("1"))

@@ -11,7 +11,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from slidernet.config.base import Integer, _Strict
+from slidernet.config.base import Integer, _Strict, unit
 
 
 class SolverConfig(_Strict):
@@ -32,13 +32,16 @@ class SolverConfig(_Strict):
         "auto", description="The compiled kernel: 'auto' picks the one the scene needs.")
     max_avalanche: Annotated[Integer, Field(ge=1)] = Field(
         100_000_000, description="Slips after which an avalanche that has not ended stops the run with an "
-                                 "AvalancheError.")
+                                 "AvalancheError.", json_schema_extra=unit("slips"))
     batch: Annotated[Integer, Field(ge=1)] = Field(
         1 << 16, description="Random draws that wait in the kernels' buffers; never changes a result. A stop "
-                             "request is seen at every refill: with slip = 'exact' in 2D at most 32 wait.")
+                             "request is seen at every refill: with slip = 'exact' in 2D at most 32 wait.",
+        json_schema_extra=unit("draws"))
     recompute_every: Annotated[Integer, Field(ge=0)] = Field(
-        10_000_000, description="Slips between two resets of the forces from the displacements (0: never).")
+        10_000_000, description="Slips between two resets of the forces from the displacements (0: never).",
+        json_schema_extra=unit("slips"))
     slip: Literal["straight", "exact"] = Field(
         "straight", description="2D slips: along the force in a straight line, or integrated exactly.")
     max_events: Annotated[Integer, Field(ge=1)] = Field(
-        10_000_000, description="Rows of the event catalogue (observable 'events') kept per realization.")
+        10_000_000, description="Rows of the event catalogue (observable 'events') kept per realization.",
+        json_schema_extra=unit("rows"))

@@ -23,7 +23,7 @@ from typing import Annotated, ClassVar
 
 from pydantic import Field
 
-from slidernet.config.base import FiniteFloat, Integer, NonNegativeFloat, PositiveFloat, _Strict
+from slidernet.config.base import FiniteFloat, Integer, NonNegativeFloat, PositiveFloat, _Strict, unit
 
 
 class InjectConfig(_Strict):
@@ -48,12 +48,14 @@ class InjectConfig(_Strict):
     c: NonNegativeFloat = Field(
         description="Amplitude of the injected rise of mu_s, per unit of ln(1 + t / t0) (dimensionless; "
                     "c ln 10 per decade of t late in the run). 0 injects nothing: the injected outputs equal the "
-                    "plain ones.")
+                    "plain ones.", json_schema_extra=unit("1"))
     t0: PositiveFloat = Field(
-        1.0, description="The time t0 of the law c ln(1 + t / t0), in tau_th (1: tau_th).")
+        1.0, description="The time t0 of the law c ln(1 + t / t0), in tau_th (1: tau_th).",
+        json_schema_extra=unit("tau_th"))
     select: Annotated[FiniteFloat, Field(gt=0, le=1)] = Field(
         1.0, description="Share of the contacts raised, in (0, 1]: 1 raises every contact; below 1 only the "
-                         "ceil(select N) oldest by contact age (ties: the lower node index first).")
+                         "ceil(select N) oldest by contact age (ties: the lower node index first).",
+        json_schema_extra=unit("1"))
 
     def shift(self, t: float) -> float:
         """The rise of a raised threshold at time ``t`` (tau_th): c ln(1 + t / t0).
@@ -108,15 +110,17 @@ class TiltConfig(_Strict):
     _omit_if_default: ClassVar[tuple[str, ...]] = ("repeats",)
 
     min_slips: Annotated[Integer, Field(ge=1)] = Field(
-        1, description="Slips of every node within the sliding avalanche (1: the rule of every earlier result).")
+        1, description="Slips of every node within the sliding avalanche (1: the rule of every earlier result).",
+        json_schema_extra=unit("slips"))
     min_displacement: Annotated[FiniteFloat, Field(ge=0)] = Field(
         0.0, description="Displacement of the centre of mass along +x within the sliding avalanche, in "
                          "reference slips (1 + e)(<mu_s> - mu_d) <N_i> Ntilde l0 / <k> of one slider held by "
-                         "one spring of the mean stiffness <k> (0: none asked).")
+                         "one spring of the mean stiffness <k> (0: none asked).", json_schema_extra=unit("ell"))
     repeats: Annotated[Integer, Field(ge=1)] = Field(
         1, description="Independent network tilt tests per recorded time, read one after the other from the "
                        "tilt stream (1: one, the result of every earlier run to the bit). mu_eff pools them; "
-                       "mu_eff_realization is their mean, mu_eff_spread their standard deviation.")
+                       "mu_eff_realization is their mean, mu_eff_spread their standard deviation.",
+        json_schema_extra=unit("1"))
     inject: InjectConfig | None = Field(
         None, description="A known aging injected into the tested copy of the state, tested beside every test "
                           "at the recorded times: the network tilt test of mu_eff and the slide-hold-slide "

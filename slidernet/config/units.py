@@ -14,7 +14,7 @@ from typing import Any
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
-from slidernet.config.base import PositiveFloat, _Strict
+from slidernet.config.base import PositiveFloat, _Strict, unit
 from slidernet.config.plugins import _takes_sigma_theta
 from slidernet.errors import ConfigError
 from slidernet.model import units
@@ -41,16 +41,21 @@ class UnitsConfig(_Strict):
     material: str | None = Field(
         None, description="A preset material: 'steel', 'glass', 'granite' or 'pmma' (explicit values "
                           "override it).")
-    rho: PositiveFloat | None = Field(None, description="Density of the sliders, in kg/m^3.")
-    Y: PositiveFloat | None = Field(None, description="Young's modulus, in Pa.")
-    alpha: PositiveFloat | None = Field(None, description="Linear thermal expansion coefficient, in 1/K.")
-    conductivity: PositiveFloat | None = Field(None, description="Thermal conductivity, in W/(m K).")
-    heat_capacity: PositiveFloat | None = Field(None, description="Specific heat capacity, in J/(kg K).")
-    size: PositiveFloat = Field(description="Size of a slider, l0, in m.")
+    rho: PositiveFloat | None = Field(None, description="Density of the sliders, in kg/m^3.",
+                                      json_schema_extra=unit("kg/m^3"))
+    Y: PositiveFloat | None = Field(None, description="Young's modulus, in Pa.", json_schema_extra=unit("Pa"))
+    alpha: PositiveFloat | None = Field(None, description="Linear thermal expansion coefficient, in 1/K.",
+                                        json_schema_extra=unit("1/K"))
+    conductivity: PositiveFloat | None = Field(None, description="Thermal conductivity, in W/(m K).",
+                                               json_schema_extra=unit("W/(m K)"))
+    heat_capacity: PositiveFloat | None = Field(None, description="Specific heat capacity, in J/(kg K).",
+                                                json_schema_extra=unit("J/(kg K)"))
+    size: PositiveFloat = Field(description="Size of a slider, l0, in m.", json_schema_extra=unit("m"))
     delta_T: PositiveFloat | None = Field(
         None, description="Standard deviation of the temperature, in K (not an amplitude): gives "
-                          "sigma_theta = alpha delta_T.")
-    g: PositiveFloat = Field(units.G_STANDARD, description="Acceleration of gravity, in m/s^2.")
+                          "sigma_theta = alpha delta_T.", json_schema_extra=unit("K"))
+    g: PositiveFloat = Field(units.G_STANDARD, description="Acceleration of gravity, in m/s^2.",
+                             json_schema_extra=unit("m/s^2"))
 
     @field_validator("material")
     @classmethod

@@ -37,6 +37,9 @@ back the same whichever wrote it (:func:`read_result`):
   coordinate that is not a dimension's is named in the ``coordinates``
   attribute of the variables it labels (CF, as xarray writes and reads it),
   so that it reads back as a coordinate.
+
+The layout and the attributes of a result, for a user who reads one, are in
+``docs/guides/file-formats.md``.
 """
 
 from __future__ import annotations

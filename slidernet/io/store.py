@@ -38,7 +38,8 @@ The set of finished realizations is read from the blocks themselves (not from
 a list that could disagree with them). A block or a partial file is read only
 if it names this run's digest. Once ``result.nc`` is written the checkpoint
 folder is removed, and when the run lets its lock go the lock file too: a
-finished run leaves ``DIR/result.nc`` alone.
+finished run leaves ``DIR/result.nc`` alone. ``docs/guides/file-formats.md``
+says this for a user.
 """
 
 from __future__ import annotations

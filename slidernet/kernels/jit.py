@@ -33,6 +33,7 @@ import contextlib
 import functools
 import hashlib
 import os
+import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import ClassVar
@@ -91,6 +92,11 @@ def _file_digest(path: str) -> str:
     return hashlib.sha1(Path(path).read_bytes()).hexdigest()[:16]
 
 
+def cache_root() -> str:
+    """The folder that holds :func:`cache_dir` of every version of the sources (``NUMBA_CACHE_DIR`` when set)."""
+    return os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
+
+
 def cache_dir() -> str:
     """Where numba keeps slidernet's compiled kernels: a folder per version of their sources.
 
@@ -102,8 +108,56 @@ def cache_dir() -> str:
     ``pip uninstall`` and then shadow an editable install as an empty
     namespace package.
     """
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(platformdirs.user_cache_dir("slidernet"), "numba")
-    return os.path.join(base, sources_digest())
+    return os.path.join(cache_root(), sources_digest())
+
+
+#: The files slidernet's cache folders hold: numba's index (``.nbi``) and machine code (``.nbc``) of each
+#: function, and the compile locks of :func:`compile_lock`.
+_CACHE_SUFFIXES = (".nbi", ".nbc")
+#: A version's folder: 16 hex digits of :func:`sources_digest`; nothing else under the root is slidernet's
+#: (``NUMBA_CACHE_DIR`` may hold other packages' caches beside it).
+_VERSION_FOLDER = re.compile(r"[0-9a-f]{16}")
+
+
+def _is_cache_file(name: str) -> bool:
+    return name.endswith(_CACHE_SUFFIXES) or (name.startswith("compile-") and name.endswith(".lock"))
+
+
+def cache_files() -> list[Path]:
+    """slidernet's compiled-kernel files under :func:`cache_root`, every version of the sources; [] without one.
+
+    Only the files of the folders named by a sources digest, and of the
+    kinds numba and :func:`compile_lock` write there, are counted.
+    """
+    root = Path(cache_root())
+    if not root.is_dir():
+        return []
+    found = []
+    for version in sorted(root.iterdir()):
+        if version.is_dir() and not version.is_symlink() and _VERSION_FOLDER.fullmatch(version.name):
+            found += [path for path in sorted(version.rglob("*"))
+                      if path.is_file() and not path.is_symlink() and _is_cache_file(path.name)]
+    return found
+
+
+def clear_cache() -> tuple[int, int]:
+    """Remove slidernet's compiled kernels (:func:`cache_files`) and the folders left empty; (files, bytes).
+
+    Nothing else under :func:`cache_root` is touched; a root that does not
+    exist is nothing to clear. The next run compiles the kernels again.
+    """
+    files = cache_files()
+    size = 0
+    for path in files:
+        size += path.stat().st_size
+        path.unlink()
+    root = Path(cache_root())
+    for version in {path.relative_to(root).parts[0] for path in files}:
+        folders = [root / version, *(root / version).rglob("*")]
+        for folder in sorted(folders, key=lambda p: len(p.parts), reverse=True):  # the deepest first
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
+    return len(files), size
 
 
 class _SourcesLocator(caching._CacheLocator):
@@ -221,4 +275,5 @@ def on_first_compile(notice: Callable[[], None]) -> Iterator[_FirstCompile]:
         yield listener
 
 
-__all__ = ["cache_dir", "cached_jit", "compile_lock", "kernel_jit", "on_first_compile", "sources_digest"]
+__all__ = ["cache_dir", "cache_files", "cache_root", "cached_jit", "clear_cache", "compile_lock", "kernel_jit",
+           "on_first_compile", "sources_digest"]

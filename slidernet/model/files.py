@@ -11,7 +11,8 @@ without the ``y`` the others have, a spring listed twice (a GraphML parallel
 edge, or both directions of a directed graph, as an edge list listing it
 twice) or joining a node to itself: each is refused with the file and the
 line, or the element, where it stands. An empty cell of a CSV file takes the
-default of its column (the header names the columns a row fills).
+default of its column (the header names the columns a row fills). The
+formats, with example files, are in ``docs/guides/file-formats.md``.
 """
 
 from __future__ import annotations

@@ -36,7 +36,9 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
+from typing import Any
 
 from slidernet._validation import check_scalar
 from slidernet.errors import ConfigError
@@ -354,6 +356,93 @@ class Dimensionless:
         else:
             lines.append(f"{'tau_th':<20}{f'{self.tau_th:.3g} s':<10} l0^2 rho c / lambda")
         return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A value of the setup as the command line takes it: a number with its unit, read into SI.
+
+    Attributes
+    ----------
+    unit : str
+        The SI unit the value is converted to, as pint reads it (``"m"``, ``"K"``).
+    what : str
+        What the value is, for a message (``"a length"``).
+    examples : tuple of str
+        Ways to write it, for a message (``("10cm", "0.1m")``).
+    """
+
+    unit: str
+    what: str
+    examples: tuple[str, ...]
+
+
+#: The quantities of a setup, by their parameter's name: a bare number is refused for each, since none has a
+#: unit a physicist would take for granted (a slider of "10" is 10 m or 10 cm; a delta_T of "300" is a
+#: temperature, not a standard deviation of one).
+QUANTITIES = {
+    "size": Quantity("m", "a length", ("10cm", "0.1m")),
+    "delta_T": Quantity("K", "a temperature difference", ("0.01K", "10mK")),
+    "rho": Quantity("kg/m^3", "a density", ("7800kg/m^3", "7.8g/cm^3")),
+    "Y": Quantity("Pa", "a Young's modulus", ("200GPa", "2e11Pa")),
+    "alpha": Quantity("1/K", "a thermal expansion coefficient", ("12e-6/K", "12ppm/K")),
+    "conductivity": Quantity("W/(m K)", "a thermal conductivity", ("50W/m/K",)),
+    "heat_capacity": Quantity("J/(kg K)", "a specific heat capacity", ("450J/kg/K",)),
+    "g": Quantity("m/s^2", "an acceleration", ("9.81m/s^2",)),
+}
+
+
+def read_quantity(text: str, param: str, option: str | None = None) -> float:
+    """The value of ``param`` written as ``text``, a number with its unit, in the SI unit of :data:`QUANTITIES`.
+
+    pint reads the unit (any unit of the right dimension: ``10cm``,
+    ``0.1 m``, ``4in``); a bare number, a unit of another dimension, and an
+    absolute temperature scale for ``delta_T`` (``3degC`` is 276.15 K;
+    its difference is ``3delta_degC``) are refused with a message that
+    names ``option`` (default: the parameter) and a way to write it.
+
+    Examples
+    --------
+    >>> read_quantity("10cm", "size"), read_quantity("10 mK", "delta_T"), read_quantity("200GPa", "Y")
+    (0.1, 0.01, 200000000000.0)
+    >>> read_quantity("0.1", "size", "--size")
+    Traceback (most recent call last):
+    ...
+    slidernet.errors.ConfigError: The '--size' option must be a length with its unit, such as --size 10cm or \
+--size 0.1m: a bare number is ambiguous. Got '0.1' instead.
+    """
+    import pint  # here only: 0.5 s to import and 0.3 s to build its registry, which only `slidernet units` needs
+
+    spec = QUANTITIES[param]
+    name = option or param
+    write = " or ".join(f"{name} {example}" if option else f"{example!r}" for example in spec.examples)
+    where = f"The {name!r} option" if option else f"The {param!r} parameter of {_OWNER}"
+
+    def refuse(why: str) -> ConfigError:
+        return ConfigError(f"{where} must be {spec.what} with its unit, such as {write}{why}. "
+                           f"Got {text!r} instead.")
+
+    registry = _unit_registry()
+    try:
+        value = registry.Quantity(text)
+    except pint.errors.OffsetUnitCalculusError:
+        raise refuse(" (a temperature difference in degrees Celsius is written delta_degC)") from None
+    except Exception:  # pint's parser raises many kinds (an undefined unit, a syntax error, a bad token)
+        raise refuse(": pint cannot read it as a number and a unit") from None
+    if not isinstance(value, registry.Quantity) or value.dimensionless:
+        raise refuse(": a bare number is ambiguous")
+    try:
+        return float(value.to(spec.unit).magnitude)
+    except pint.errors.DimensionalityError:
+        raise refuse(f": its unit, {value.units:~}, is not that of {spec.what}") from None
+
+
+@functools.cache
+def _unit_registry() -> Any:
+    """pint's registry of units, built once (pint is imported only here and in :func:`read_quantity`)."""
+    import pint
+
+    return pint.UnitRegistry()
 
 
 def setup(

@@ -61,6 +61,9 @@ class GaussianSteps:
     # Parameters for slidernet.testing.check_driver and the plugin contract test.
     example_params: ClassVar[dict[str, Any]] = {"sigma_theta": 1e-6}
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"sigma_theta": "1"}
+
     def __init__(self, sigma_theta: float) -> None:
         self.sigma_theta = check_scalar(sigma_theta, "sigma_theta", "gaussian_steps", "> 0")
 
@@ -119,6 +122,9 @@ class OrnsteinUhlenbeck:
 
     # Parameters for slidernet.testing.check_driver and the plugin contract test.
     example_params: ClassVar[dict[str, Any]] = {"sigma_theta": 1e-6, "tau_c": 2.0}
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"sigma_theta": "1", "tau_c": "tau_th", "theta0": "1"}
 
     def __init__(self, sigma_theta: float, tau_c: float, theta0: float = 0.0) -> None:
         self.sigma_theta = check_scalar(sigma_theta, "sigma_theta", "ornstein_uhlenbeck", "> 0")
@@ -183,6 +189,15 @@ class Sinusoidal:
 
     # Parameters for slidernet.testing.check_driver and the plugin contract test.
     example_params: ClassVar[dict[str, Any]] = {"amplitude": 1e-6, "period": 100.0}
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {
+        "amplitude": "1",
+        "period": "tau_th",
+        "phase": "rad",
+        "noise_std": "1",
+        "theta0": "1",
+    }
 
     def __init__(self, amplitude: float, period: float, phase: float = 0.0, noise_std: float = 0.0,
                  theta0: float = 0.0) -> None:
@@ -254,6 +269,9 @@ class Ramp:
     # Parameters for slidernet.testing.check_driver and the plugin contract test.
     example_params: ClassVar[dict[str, Any]] = {"rate": 1e-7, "period": 20.0}
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"rate": "1/tau_th", "theta0": "1", "period": "tau_th"}
+
     def __init__(self, rate: float, theta0: float = 0.0, period: float | None = None) -> None:
         self.rate = check_scalar(rate, "rate", "ramp", "!= 0")
         self.theta0 = check_scalar(theta0, "theta0", "ramp")
@@ -292,6 +310,9 @@ class Constant:
 
     # Parameters for slidernet.testing.check_driver and the plugin contract test.
     example_params: ClassVar[dict[str, Any]] = {"theta0": 1e-7}
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"theta0": "1"}
 
     def __init__(self, theta0: float = 0.0) -> None:
         self.theta0 = check_scalar(theta0, "theta0", "constant")
@@ -355,7 +376,8 @@ class Series:
     are skipped. The times must be strictly increasing but need not be evenly
     spaced: T is interpolated linearly between samples, which is also how
     the solver treats theta between two t_q. The file is read, and checked,
-    once, in the constructor; the ``rng`` is not used.
+    once, in the constructor; the ``rng`` is not used. The format, with an
+    example: ``docs/guides/file-formats.md``.
 
     Parameters
     ----------
@@ -407,6 +429,16 @@ class Series:
     slidernet.errors.ConfigError: The temperature file '...T.csv' of the series driver covers 4 steps ...
     >>> folder.cleanup()
     """
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {
+        "path": "—",
+        "kappa": "1/(the file's temperature unit)",
+        "T0": "the file's temperature unit",
+        "tau_th": "the file's time unit",
+        "t0": "the file's time unit",
+        "delimiter": "—",
+    }
 
     def __init__(self, path: str | os.PathLike, kappa: float, T0: float, tau_th: float, t0: float | None = None,
                  delimiter: str = ",") -> None:

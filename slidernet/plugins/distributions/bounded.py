@@ -45,6 +45,9 @@ class Uniform(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"low": 0.45, "high": 0.65}
     _mu_d_param = "high"
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"low": "1", "high": "1"}
+
     def __init__(self, low: float, high: float) -> None:
         self.low = check_scalar(low, "low", "uniform")
         self.high = check_scalar(high, "high", "uniform")
@@ -118,6 +121,9 @@ class Constant(Distribution):
     name = "constant"
     example_params: ClassVar[dict[str, Any]] = {"value": 0.6}
     _mu_d_param = "value"
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"value": "1"}
 
     def __init__(self, value: float) -> None:
         self.value = check_scalar(value, "value", "constant")

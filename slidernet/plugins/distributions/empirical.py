@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -25,6 +25,8 @@ class Empirical(Distribution):
     is above mu_d no truncation is needed. mu_max saturates at the largest
     value: E[max of m] = sum_k v_(k) [(k/K)^m - ((k-1)/K)^m] over the K
     sorted values v_(k) above mu_d.
+
+    The file's format, with examples: ``docs/guides/file-formats.md``.
 
     Parameters
     ----------
@@ -56,6 +58,9 @@ class Empirical(Distribution):
 
     name = "empirical"
     _mu_d_param = "path"
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"path": "—", "column": "—", "delimiter": "—"}
 
     def __init__(self, path: str | os.PathLike, column: int | str | None = None, delimiter: str = ",") -> None:
         if not isinstance(path, (str, os.PathLike)) or not str(path):

@@ -52,6 +52,9 @@ distribution of scipy.stats (e.g. 'gamma'). Got 'poisson' instead.
     example_params: ClassVar[dict[str, Any]] = {"dist": "gamma", "params": {"a": 2.0, "loc": 0.45, "scale": 0.05}}
     _mu_d_param = "params"
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"dist": "—", "params": "1"}
+
     def __init__(self, dist: str, params: Mapping[str, float] | None = None) -> None:
         law = getattr(stats, dist, None) if isinstance(dist, str) and not dist.startswith("_") else None
         if not isinstance(law, stats.rv_continuous):

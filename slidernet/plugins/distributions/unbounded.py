@@ -53,6 +53,9 @@ class Gaussian(Distribution):
     example_params: ClassVar[dict[str, Any]] = {"mean": 0.6, "std": 0.01}
     _mu_d_param = "mean"
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"mean": "1", "std": "1"}
+
     def __init__(self, mean: float, std: float) -> None:
         self.mean = check_scalar(mean, "mean", "gaussian")
         self.std = check_scalar(std, "std", "gaussian", "> 0")
@@ -128,6 +131,9 @@ class Weibull(Distribution):
     name = "weibull"
     example_params: ClassVar[dict[str, Any]] = {"shape": 2.0, "scale": 0.15, "loc": 0.4}
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"shape": "1", "scale": "1", "loc": "1"}
+
     def __init__(self, shape: float, scale: float, loc: float = 0.0) -> None:
         self.shape = check_scalar(shape, "shape", "weibull", "> 0")
         self.scale = check_scalar(scale, "scale", "weibull", "> 0")
@@ -197,6 +203,9 @@ class Lognormal(Distribution):
     name = "lognormal"
     example_params: ClassVar[dict[str, Any]] = {"median": 0.1, "sigma": 0.5, "loc": 0.45}
 
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"median": "1", "sigma": "1", "loc": "1"}
+
     def __init__(self, median: float, sigma: float, loc: float = 0.0) -> None:
         self.median = check_scalar(median, "median", "lognormal", "> 0")
         self.sigma = check_scalar(sigma, "sigma", "lognormal", "> 0")
@@ -263,6 +272,9 @@ class Exponential(Distribution):
 
     name = "exponential"
     example_params: ClassVar[dict[str, Any]] = {"scale": 0.05, "loc": 0.45}
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"scale": "1", "loc": "1"}
 
     def __init__(self, scale: float, loc: float = 0.0) -> None:
         self.scale = check_scalar(scale, "scale", "exponential", "> 0")
@@ -340,6 +352,9 @@ class Pareto(Distribution):
 
     name = "pareto"
     example_params: ClassVar[dict[str, Any]] = {"alpha": 3.0, "scale": 0.05, "loc": 0.5}
+
+    #: The unit of each parameter, for the configuration reference ("1": dimensionless).
+    param_units: ClassVar[dict[str, str]] = {"alpha": "1", "scale": "1", "loc": "1"}
 
     def __init__(self, alpha: float, scale: float, loc: float = 0.0) -> None:
         self.alpha = check_scalar(alpha, "alpha", "pareto", "> 0")
