@@ -219,7 +219,7 @@ TIME_PANELS = (
 )
 #: The panel of the observable ``contact_age``, after :data:`TIME_PANELS` where the result records it.
 CONTACT_AGE_PANEL = ("contact_age", "contact_age",
-                     r"contact age ($\tau_\mathrm{th}$; mean over the nodes of the time since their last slip)")
+                     r"contact age ($\tau_\mathrm{th}$, mean over the nodes)")
 
 
 def time_panels(ds: xr.Dataset) -> tuple[tuple[str, str, str], ...]:
@@ -322,13 +322,25 @@ def _read(path: Path) -> xr.Dataset | xr.DataTree:
                           f"{getattr(exc, 'strerror', None) or exc}.") from None
 
 
+def _load(result: xr.Dataset | xr.DataTree | str | os.PathLike[str],
+          read_from: str | None) -> tuple[xr.Dataset | xr.DataTree, str, str | None]:
+    """A result given as data or as a path: (its data, how errors name it, the file's name for a title)."""
+    if isinstance(result, (xr.Dataset, xr.DataTree)):
+        if read_from is None:
+            return result, "The dataset", None
+        return result, f"The file {read_from!r}", Path(read_from).name
+    file = Path(result)
+    return _read(file), f"The file {str(file)!r}", file.name
+
+
 def _check_result(ds: xr.Dataset | xr.DataTree, source: str) -> None:
     """Refuse a dataset that is not one run of slidernet (no n over (realization, t))."""
     if isinstance(ds, xr.DataTree):
         raise ResultError(
             f"{source} holds a sweep whose points differ in number of nodes (an xarray DataTree: the stacked "
             "variables at its root, each point's per-node variables in its group point_<i>), not one run. "
-            "Plot one point: its own result, OUT/points/<i>/result.nc of `slidernet sweep --out OUT`."
+            "Plot it with slidernet.analysis.sweep_plots.plot_sweep (`slidernet plot` does), or one point: its "
+            "own result, OUT/points/<i>/result.nc of `slidernet sweep --out OUT`."
         )
     missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
                                         ("n_mean", "n_mean" in ds.data_vars)) if not there]
@@ -343,8 +355,9 @@ def _check_result(ds: xr.Dataset | xr.DataTree, source: str) -> None:
         extra = [d for d in ds["n"].dims if d not in ("realization", "t")]
         raise ResultError(
             f"{source} holds more than one run: its 'n' has dims {ds['n'].dims}, with {extra} besides "
-            "(realization, t), as a sweep has. Plot one point: select it, e.g. ds.isel("
-            f"{extra[0]}=0), and pass that dataset to slidernet.analysis.plots.plot_result."
+            "(realization, t), as a sweep has. Plot a sweep's result with "
+            f"slidernet.analysis.sweep_plots.plot_sweep, or one point: select it, e.g. ds.isel({extra[0]}=0), "
+            "and pass that dataset to plot_result."
         )
 
 
@@ -361,14 +374,13 @@ def _summary(cfg: dict[str, Any], ds: xr.Dataset, options: list[tuple[str, str]]
     (:func:`non_default_options`) where there are any."""
 
     def plugin(spec: dict[str, Any]) -> str:
-        params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                           for k, v in spec.items() if k != "name")
+        params = ", ".join(f"{k} = {_words(v)}" for k, v in spec.items() if k != "name")
         return f"{spec.get('name')}({params})"
 
     return (f"{geometry_words(cfg)}, {ds.sizes['realization']} realizations of {cfg.get('steps')} "
             rf"$\tau_\mathrm{{th}}$, seed {ds.attrs.get('seed', cfg.get('seed'))}, "
             f"kernel {ds.attrs.get('kernel', '?')}\n"
-            rf"$\tilde N$ = {cfg['network']['Ntilde']:g}, $\mu_d$ = {cfg['friction']['mu_d']:g}, "
+            rf"$\tilde N$ = {_words(cfg['network']['Ntilde'])}, $\mu_d$ = {_words(cfg['friction']['mu_d'])}, "
             rf"$p(\mu_s)$ = {plugin(cfg['friction']['static'])}, driver {plugin(cfg['driver'])}"
             + ("\noptions not at their default: " + ", ".join(words for _, words in options) if options else ""))
 
@@ -411,7 +423,7 @@ def _time_panel(ax: Axes, ds: xr.Dataset, name: str, observable: str, ylabel: st
 
 
 def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.PathLike[str] | None = None, *,
-                figure: Figure | None = None, dpi: int = DPI) -> Figure:
+                figure: Figure | None = None, dpi: int = DPI, read_from: str | None = None) -> Figure:
     r"""The standard panels of a result: what to look at before reading the numbers.
 
     Four panels against t (tau_th; a logarithmic axis over t > 0): the
@@ -444,6 +456,9 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
         figure, outside pyplot.
     dpi : int
         Resolution of a raster file, in dots per inch.
+    read_from : str, optional
+        The path of the file that ``result``, a dataset, was read from: the
+        title and the errors name it.
 
     Returns
     -------
@@ -482,11 +497,7 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     """
     from slidernet.config import build_network, load_config
 
-    if isinstance(result, (xr.Dataset, xr.DataTree)):
-        ds, source, name = result, "The dataset", None
-    else:
-        file = Path(result)
-        ds, source, name = _read(file), f"The file {str(file)!r}", file.name
+    ds, source, name = _load(result, read_from)
     _check_result(ds, source)
     if path is not None:
         _check_format(Path(path))
