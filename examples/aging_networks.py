@@ -103,6 +103,7 @@ from matplotlib.figure import Figure
 
 import slidernet
 from slidernet.analysis.mechanism import node_states, node_summary
+from slidernet.analysis.observables import align_avalanche_sizes
 from slidernet.analysis.trend import mean_sem
 from slidernet.ensemble.sweep import sweep
 from slidernet.io import atomic_output, save_figure, write_json
@@ -404,7 +405,8 @@ def run_sweeps(group: Group, params: str, preset: Preset, workers: int | None, s
             configs[i].append(point_configs[i])
     merged = []
     for i in range(len(group.sizes)):
-        parts = per_size[i]
+        # Each geometry's avalanche histogram ends at its own largest avalanche: padded with empty bins.
+        parts = align_avalanche_sizes(per_size[i])
         R = parts[0].sizes["realization"]
         ds = xr.concat([p.assign_coords(realization=np.arange(R) + g * R) for g, p in enumerate(parts)],
                        dim="realization", data_vars="minimal", coords="minimal", compat="override")

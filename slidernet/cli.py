@@ -91,12 +91,15 @@ def _parser() -> argparse.ArgumentParser:
 
     pl = sub.add_parser(
         "plot", help="draw the standard panels of a result: n, mu_max, <x_G^2>, mu_eff against t, with the "
-                     "paper's laws; a network's slip map and mu_s field",
+                     "paper's laws; a network's slip map and mu_s field; a sweep's points against t and the "
+                     "swept key",
         description="Reads a result of `slidernet run` and writes RESULT.png beside it (or --out PATH): "
                     "ensemble means +- one standard error against t, the closed forms of the two-slider "
-                    "model where they apply, and for a network its slip map and mu_s field (realization 0).",
+                    "model where they apply, and for a network its slip map and mu_s field (realization 0). "
+                    "A result of `slidernet sweep` gets one curve per point against t, and each observable's "
+                    "value at the last recorded time against the swept key.",
     )
-    pl.add_argument("result", type=Path, help="a result file (DIR/result.nc of slidernet run)")
+    pl.add_argument("result", type=Path, help="a result file (DIR/result.nc of slidernet run or sweep)")
     pl.add_argument("--out", type=Path, help="the picture's path; its suffix picks the format (.png, .pdf, "
                                              ".svg); a folder gets RESULT.png (default: RESULT.png beside RESULT)")
     pl.add_argument("--show", action="store_true",
@@ -247,7 +250,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from slidernet.analysis.plots import plot_result
+    from slidernet.analysis.sweep_plots import plot as plot_result  # a run's panels, or a sweep's
     from slidernet.errors import ConfigError
 
     out = args.out

@@ -14,7 +14,7 @@ import xarray as xr
 
 import slidernet
 from slidernet.analysis import theory
-from slidernet.analysis.plots import plot_result, theory_overlays
+from slidernet.analysis.plots import non_default_options, plot_result, theory_overlays
 from slidernet.cli import main
 from slidernet.config import load_config
 from slidernet.errors import ResultError
@@ -265,3 +265,48 @@ def test_the_laws_of_the_papers_slip_are_not_drawn_for_another_overshoot(results
     for key in ("n", "x_G2"):
         assert overlays[key].values is None and "friction.overshoot = 1" in overlays[key].reason
     assert overlays["mu_max_exact"].values is not None  # the law of the max of n + 2 draws does not use the slip
+
+
+# --------------------------------------------------------------------------
+# The title: every option that is not the default; the contact-age panel
+# --------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def strengthened_pair() -> xr.Dataset:
+    """A pair with a damped slip and ageing thresholds, recording the contact age."""
+    cfg = _config({"kind": "two_slider"}, 30, 2, ["n", "mu_max", "x_G", "contact_age"])
+    cfg["friction"].update(overshoot=0.5, strengthening={"beta": 0.02, "tau_c": 3.0})
+    return slidernet.run(cfg, progress=False)
+
+
+def test_the_title_names_every_option_that_is_not_the_default(strengthened_pair):
+    title = plot_result(strengthened_pair)._suptitle.get_text()
+    assert "overshoot 0.5" in title
+    assert "strengthening beta=0.02, tau_c=3" in title
+
+
+def test_a_default_run_has_no_line_of_options(results):
+    title = plot_result(results["pair"])._suptitle.get_text()
+    assert title.count("\n") == 1 and "options" not in title
+
+
+def test_non_default_options_are_read_from_the_models(strengthened_pair):
+    cfg = result_config(strengthened_pair)
+    cfg["record"] = "all"
+    assert dict(non_default_options(load_config(cfg))) == {
+        "record": "record all", "friction.overshoot": "overshoot 0.5",
+        "friction.strengthening": "strengthening beta=0.02, tau_c=3"}
+    del cfg["friction"]["overshoot"], cfg["friction"]["strengthening"]
+    cfg.update(dynamics={"tau_ratio": 1e-3}, observables=["n"])
+    assert dict(non_default_options(load_config(cfg))) == {"record": "record all",
+                                                           "dynamics": "dynamics tau_ratio=0.001"}
+
+
+def test_a_result_with_contact_age_gets_its_panel(strengthened_pair, results):
+    fig = plot_result(strengthened_pair)
+    ax = fig.axes[4]
+    assert ax.get_ylabel().startswith("contact age")
+    mean = strengthened_pair["contact_age_mean"].values
+    np.testing.assert_allclose(_line(ax, "mean over 2").get_ydata(), mean[strengthened_pair["t"].values > 0])
+    assert len(plot_result(results["pair"]).axes) == 4  # no contact age recorded: no panel

@@ -4,7 +4,10 @@ They fix the results of a set of scenes (the paper's pair with mu_eff, a
 chain with events, lattices under f_ext with the network tilt test, an
 irregular network with the exact slip, a sweep, a resumed run) as computed
 before the package was restructured; any change of layout or kernel code
-must leave every value and every dtype as it was.
+must leave every value and every dtype as it was. One change of layout is
+allowed for: the avalanche histogram, which the files hold in the kernels' 63
+bins, now ends at its highest occupied bin (issue 46); the bins it leaves out
+must be empty in the file.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import json
 import numpy as np
 import pytest
 
+from slidernet.analysis.observables import avalanche_bins
 from slidernet.io import read_result
 
 from .golden.make_golden import HERE, NAMES, make
@@ -25,6 +29,11 @@ VOLATILE = {"slidernet_version", "slidernet_code", "execution"}
 @pytest.mark.parametrize("case", NAMES)
 def test_golden_file_is_reproduced_bit_for_bit(case, tmp_path):
     expected = read_result(HERE / f"{case}.nc")
+    if "avalanche_count" in expected:
+        counts = expected["avalanche_count"].values
+        bins = avalanche_bins(counts)
+        assert not counts[..., bins:].any()
+        expected = expected.isel(avalanche_size=slice(0, bins))
     got = read_result(make(case, tmp_path))
     assert set(got.variables) == set(expected.variables)
     for name in expected.variables:

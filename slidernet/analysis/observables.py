@@ -93,8 +93,10 @@ CHUNK = 1024
 summed in the same order whatever the number of workers or checkpoints."""
 
 
-def _network_variables(ds: Variables, records: list[Record], first_realization: int) -> None:
-    """Variables that only network kernels record (docs/model.md: networks add their own)."""
+def _network_variables(ds: Variables, records: list[Record], first_realization: int,
+                       size_bins: int | None) -> None:
+    """Variables that only network kernels record (docs/model.md: networks add their own); the avalanche
+    counts in their first ``size_bins`` bins (None: every bin)."""
     first = records[0]
     per_t = {
         "y_G": ("centre-of-mass displacement along y since t = 0", "l0"),
@@ -106,7 +108,7 @@ def _network_variables(ds: Variables, records: list[Record], first_realization: 
             ds[name] = (("realization", "t"), np.stack([r[name] for r in records]),
                         {"long_name": long_name, "units": units})
     if "avalanche_count" in first:
-        counts = np.stack([r["avalanche_count"] for r in records])
+        counts = np.stack([r["avalanche_count"] for r in records])[:, :size_bins]
         ds["avalanche_count"] = (("realization", "avalanche_size"), counts, {
             "long_name": "number of avalanches (driving slip + triggered slips) per size bin "
                          "[s, 2 s), s = avalanche_size", "units": "1"})
@@ -188,7 +190,8 @@ def _creep_variables(ds: Variables, records: list[Record]) -> None:
                    {"long_name": long_name + "; NaN past creep_event_count", "units": units, **constants})
 
 
-def realization_variables(records: list[Record], observables: list[str], first_realization: int = 0) -> Variables:
+def realization_variables(records: list[Record], observables: list[str], first_realization: int = 0,
+                          size_bins: int | None = None) -> Variables:
     """The per-realization variables of consecutive realizations, stacked.
 
     Parameters
@@ -200,6 +203,9 @@ def realization_variables(records: list[Record], observables: list[str], first_r
         The requested observables.
     first_realization : int
         Index of ``records[0]``.
+    size_bins : int, optional
+        The avalanche size bins to keep (:func:`avalanche_bins` over every
+        realization of the result); None: every bin of the kernel's.
 
     Returns
     -------
@@ -228,7 +234,7 @@ def realization_variables(records: list[Record], observables: list[str], first_r
     if "mu_eff_spread" in records[0]:
         out["mu_eff_spread"] = (("realization", "t"), np.stack([r["mu_eff_spread"] for r in records]),
                                 ATTRS["mu_eff_spread"])
-    _network_variables(out, records, first_realization)
+    _network_variables(out, records, first_realization, size_bins)
     if "creep_events" in records[0]:
         _creep_variables(out, records)
     if "slid_away_at" in records[0]:  # a scene that can slide away (docs/model.md, 'Sliding away')
@@ -422,16 +428,19 @@ def chunks(records: Iterable[Record], size: int = CHUNK) -> Iterator[list[Record
         yield chunk
 
 
-def coordinates(t: np.ndarray, R: int, first: Record) -> dict[str, tuple]:
-    """The coordinates of the result: ``realization``, ``t``, for networks ``avalanche_size``, and with a
-    periodic driver and the observable ``creep`` ``cycle`` and ``cycle_end``."""
+def coordinates(t: np.ndarray, R: int, first: Record, size_bins: int | None = None) -> dict[str, tuple]:
+    """The coordinates of the result: ``realization``, ``t``, for networks ``avalanche_size`` (its first
+    ``size_bins`` bins; None: every bin of the kernel's), and with a periodic driver and the observable
+    ``creep`` ``cycle`` and ``cycle_end``."""
     coords: dict[str, tuple] = {
         "realization": ("realization", np.arange(R, dtype=np.int64)),
         "t": ("t", np.asarray(t, dtype=np.int64), {"long_name": "time", "units": "tau_th"}),
     }
     if "avalanche_count" in first:
-        bins = first["avalanche_count"].size
-        coords["avalanche_size"] = ("avalanche_size", 2 ** np.arange(bins, dtype=np.int64))
+        bins = first["avalanche_count"].size if size_bins is None else size_bins
+        coords["avalanche_size"] = ("avalanche_size", 2 ** np.arange(bins, dtype=np.int64), {
+            "long_name": "smallest avalanche size (slips) of the bin [s, 2 s); the bins end at the highest "
+                         "occupied in any realization", "units": "1"})
     if "contact_age_count" in first:
         # Fixed edges (kernels.AGE_EDGES), the same for every run: histograms of runs and sweeps stack.
         edges = np.concatenate([[0.0], AGE_EDGES, [np.inf]])
@@ -490,10 +499,84 @@ def assemble(
     pad_creep_events(parts)
     data = {name: (dims, np.concatenate([p[name][1] for p in parts]), a)
             for name, (dims, _, a) in parts[0].items()}
-    ds = xr.Dataset(data, coords=coordinates(t, R, first), attrs=dict(attrs))
+    size_bins = None
+    if "avalanche_count" in data:
+        dims, counts, a = data["avalanche_count"]
+        size_bins = avalanche_bins(counts)
+        data["avalanche_count"] = (dims, counts[:, :size_bins], a)
+    ds = xr.Dataset(data, coords=coordinates(t, R, first, size_bins), attrs=dict(attrs))
     for name, var in stats.finish().items():
         ds[name] = var
     return ds
+
+
+def avalanche_bins(counts: ArrayLike) -> int:
+    """The avalanche size bins a result keeps: from the first, sizes [1, 2), to the highest occupied one.
+
+    The kernels count avalanches in 63 bins [2^k, 2^(k+1)) (up to 2^62
+    slips, what int64 holds); a result keeps those up to the highest bin
+    that any realization occupies, so that its ``avalanche_size`` ends near
+    its largest avalanche. Every bin below stays, empty or not.
+
+    Parameters
+    ----------
+    counts : array_like, shape (..., B)
+        Counts (or whether any) per bin, along the last axis, e.g. the
+        kernels' ``avalanche_count`` of every realization, (R, 63).
+
+    Returns
+    -------
+    int
+        The number of bins to keep, in [1, B]: 1 where nothing is counted,
+        so that the dimension and its integer dtype stay.
+
+    Examples
+    --------
+    >>> avalanche_bins([[3, 1, 0, 0], [2, 0, 0, 0]])
+    2
+    """
+    counts = np.asarray(counts)
+    occupied = np.flatnonzero(counts.reshape(-1, counts.shape[-1]).any(axis=0))
+    return int(occupied[-1]) + 1 if occupied.size else 1
+
+
+def align_avalanche_sizes(datasets: Iterable[xr.Dataset]) -> list[xr.Dataset]:
+    """Results with the same ``avalanche_size``: each padded with empty bins to the widest, to concatenate them.
+
+    Each result's histogram ends at its own highest occupied bin
+    (:func:`avalanche_bins`), so the results of two runs differ in their
+    ``avalanche_size`` where their largest avalanches do; pad them before
+    :func:`xarray.concat`, which would otherwise fill the missing bins with
+    NaN (and make the counts float). ``xr.concat(..., join="outer",
+    fill_value={"avalanche_count": 0})`` does the same.
+
+    Parameters
+    ----------
+    datasets : iterable of xarray.Dataset
+        Results; those without ``avalanche_size`` (two sliders on the pair
+        kernel) are returned as they are.
+
+    Returns
+    -------
+    list of xarray.Dataset
+        The same results, ``avalanche_count`` padded with zeros (its dtype
+        kept) to the widest ``avalanche_size``.
+
+    Examples
+    --------
+    >>> a = xr.Dataset({"avalanche_count": (("realization", "avalanche_size"), [[4, 1]])},
+    ...                coords={"avalanche_size": [1, 2]})
+    >>> b = a.isel(avalanche_size=[0])
+    >>> align_avalanche_sizes([a, b])[1]["avalanche_count"].values.tolist()
+    [[4, 0]]
+    """
+    datasets = list(datasets)
+    widths = [ds.sizes.get("avalanche_size", 0) for ds in datasets]
+    if not any(widths):
+        return datasets
+    sizes = datasets[int(np.argmax(widths))]["avalanche_size"]
+    return [ds.reindex(avalanche_size=sizes, fill_value={"avalanche_count": 0}) if 0 < w < sizes.size else ds
+            for ds, w in zip(datasets, widths, strict=True)]
 
 
 def binned_quantile(counts: ArrayLike, lower: ArrayLike, upper: ArrayLike,

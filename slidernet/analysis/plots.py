@@ -25,6 +25,7 @@ import xarray as xr
 from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from pydantic import BaseModel
 
 from slidernet.analysis import theory
 from slidernet.analysis.network_maps import (
@@ -45,7 +46,7 @@ if TYPE_CHECKING:
 
     from slidernet.config import Config
 
-__all__ = ["EDGE_LIMIT", "Overlay", "mu_s_field", "network_of", "node_field", "plot_result",
+__all__ = ["EDGE_LIMIT", "Overlay", "mu_s_field", "network_of", "node_field", "non_default_options", "plot_result",
            "save_network_pictures", "slip_map", "theory_overlays"]
 
 
@@ -216,6 +217,95 @@ TIME_PANELS = (
     ("x_G2", "x_G", r"$\langle x_G^2\rangle$ ($l_0^2$)"),
     ("mu_eff", "mu_eff", r"$\mu_\mathrm{eff}$ (virtual tilt test)"),
 )
+#: The panel of the observable ``contact_age``, after :data:`TIME_PANELS` where the result records it.
+CONTACT_AGE_PANEL = ("contact_age", "contact_age",
+                     r"contact age ($\tau_\mathrm{th}$, mean over the nodes)")
+
+
+def time_panels(ds: xr.Dataset) -> tuple[tuple[str, str, str], ...]:
+    """The time panels of a result: :data:`TIME_PANELS`, and the contact age where it is recorded."""
+    return TIME_PANELS + ((CONTACT_AGE_PANEL,) if "contact_age_mean" in ds else ())
+
+
+# What the summary line of a figure already shows (the scene, its size and seed), or what never changes a
+# result (execution) or only says what was recorded (observables, which the panels show).
+_SHOWN = {"seed", "realizations", "steps", "observables", "execution", "units", "network.kind", "network.n",
+          "network.shape", "network.path"}
+
+
+def _words(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, BaseModel):
+        value = value.model_dump(mode="json")
+    return str(value)
+
+
+def non_default_options(config: Config) -> list[tuple[str, str]]:
+    """The options of a configuration that differ from their defaults, in a few words each.
+
+    Read from the configuration's models (every field that has a default and
+    another value), so that an option added later is named without a change
+    here; the values without a default (``network.Ntilde``, ``friction.mu_d``,
+    ``p(mu_s)``, the driver) and what a figure's summary line shows (the
+    scene, its size and seed) are left out. A table that is absent by default
+    (``[friction.strengthening]``, ``[dynamics]``) is named with its values.
+
+    Parameters
+    ----------
+    config : Config
+        A resolved configuration (e.g. of a result's ``config`` attribute).
+
+    Returns
+    -------
+    list of (str, str)
+        (dotted key, words), in the order of the models' fields, e.g.
+        ``("friction.overshoot", "overshoot 0.5")``.
+
+    Examples
+    --------
+    >>> from slidernet.config import load_config
+    >>> cfg = load_config({"steps": 10, "network": {"kind": "two_slider", "Ntilde": 1e-7},
+    ...                    "friction": {"mu_d": 0.5, "overshoot": 0.5,
+    ...                                 "strengthening": {"beta": 0.02, "tau_c": 3.0},
+    ...                                 "static": {"name": "gaussian", "mean": 0.6, "std": 0.01}},
+    ...                    "driver": {"name": "gaussian_steps", "sigma_theta": 1e-6}})
+    >>> non_default_options(cfg)
+    [('friction.overshoot', 'overshoot 0.5'), ('friction.strengthening', 'strengthening beta=0.02, tau_c=3')]
+    """
+    from slidernet.config.base import _Strict
+
+    found: list[tuple[str, str]] = []
+
+    def default(field: Any) -> Any:
+        return field.get_default(call_default_factory=True)
+
+    def table(model: BaseModel) -> str:
+        """A table absent by default: its values that are required or not at their default."""
+        fields = type(model).model_fields.items()
+        return ", ".join(f"{name}={_words(getattr(model, name))}" for name, field in fields
+                         if field.is_required() or getattr(model, name) != default(field))
+
+    def walk(model: BaseModel, prefix: str) -> None:
+        for name, field in type(model).model_fields.items():
+            key, value = prefix + name, getattr(model, name)
+            if key in _SHOWN:
+                continue
+            if field.is_required():
+                if isinstance(value, _Strict):  # a table of options (network, friction), not a plugin's values
+                    walk(value, key + ".")
+                continue
+            if value == default(field):
+                continue
+            if isinstance(value, _Strict) and isinstance(default(field), _Strict):
+                walk(value, key + ".")
+            elif isinstance(value, _Strict):
+                found.append((key, f"{name} {table(value)}"))
+            else:
+                found.append((key, f"{name} {_words(value)}"))
+
+    walk(config, "")
+    return found
 
 
 def _read(path: Path) -> xr.Dataset | xr.DataTree:
@@ -232,13 +322,25 @@ def _read(path: Path) -> xr.Dataset | xr.DataTree:
                           f"{getattr(exc, 'strerror', None) or exc}.") from None
 
 
+def _load(result: xr.Dataset | xr.DataTree | str | os.PathLike[str],
+          read_from: str | None) -> tuple[xr.Dataset | xr.DataTree, str, str | None]:
+    """A result given as data or as a path: (its data, how errors name it, the file's name for a title)."""
+    if isinstance(result, (xr.Dataset, xr.DataTree)):
+        if read_from is None:
+            return result, "The dataset", None
+        return result, f"The file {read_from!r}", Path(read_from).name
+    file = Path(result)
+    return _read(file), f"The file {str(file)!r}", file.name
+
+
 def _check_result(ds: xr.Dataset | xr.DataTree, source: str) -> None:
     """Refuse a dataset that is not one run of slidernet (no n over (realization, t))."""
     if isinstance(ds, xr.DataTree):
         raise ResultError(
             f"{source} holds a sweep whose points differ in number of nodes (an xarray DataTree: the stacked "
             "variables at its root, each point's per-node variables in its group point_<i>), not one run. "
-            "Plot one point: its own result, OUT/points/<i>/result.nc of `slidernet sweep --out OUT`."
+            "Plot it with slidernet.analysis.sweep_plots.plot_sweep (`slidernet plot` does), or one point: its "
+            "own result, OUT/points/<i>/result.nc of `slidernet sweep --out OUT`."
         )
     missing = [name for name, there in (("t", "t" in ds.coords), ("n", "n" in ds.data_vars),
                                         ("n_mean", "n_mean" in ds.data_vars)) if not there]
@@ -253,8 +355,9 @@ def _check_result(ds: xr.Dataset | xr.DataTree, source: str) -> None:
         extra = [d for d in ds["n"].dims if d not in ("realization", "t")]
         raise ResultError(
             f"{source} holds more than one run: its 'n' has dims {ds['n'].dims}, with {extra} besides "
-            "(realization, t), as a sweep has. Plot one point: select it, e.g. ds.isel("
-            f"{extra[0]}=0), and pass that dataset to slidernet.analysis.plots.plot_result."
+            "(realization, t), as a sweep has. Plot a sweep's result with "
+            f"slidernet.analysis.sweep_plots.plot_sweep, or one point: select it, e.g. ds.isel({extra[0]}=0), "
+            "and pass that dataset to plot_result."
         )
 
 
@@ -266,19 +369,20 @@ def _check_format(path: Path) -> None:
                           f"cannot write. Use one of: {', '.join('.' + f for f in sorted(formats))}.")
 
 
-def _summary(cfg: dict[str, Any], ds: xr.Dataset) -> str:
-    """Two lines on the run: scene, size, seed; then the parameters of the model."""
+def _summary(cfg: dict[str, Any], ds: xr.Dataset, options: list[tuple[str, str]] = ()) -> str:
+    """Two lines on the run: scene, size, seed; then the parameters of the model; a third with ``options``
+    (:func:`non_default_options`) where there are any."""
 
     def plugin(spec: dict[str, Any]) -> str:
-        params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                           for k, v in spec.items() if k != "name")
+        params = ", ".join(f"{k} = {_words(v)}" for k, v in spec.items() if k != "name")
         return f"{spec.get('name')}({params})"
 
     return (f"{geometry_words(cfg)}, {ds.sizes['realization']} realizations of {cfg.get('steps')} "
             rf"$\tau_\mathrm{{th}}$, seed {ds.attrs.get('seed', cfg.get('seed'))}, "
             f"kernel {ds.attrs.get('kernel', '?')}\n"
-            rf"$\tilde N$ = {cfg['network']['Ntilde']:g}, $\mu_d$ = {cfg['friction']['mu_d']:g}, "
-            rf"$p(\mu_s)$ = {plugin(cfg['friction']['static'])}, driver {plugin(cfg['driver'])}")
+            rf"$\tilde N$ = {_words(cfg['network']['Ntilde'])}, $\mu_d$ = {_words(cfg['friction']['mu_d'])}, "
+            rf"$p(\mu_s)$ = {plugin(cfg['friction']['static'])}, driver {plugin(cfg['driver'])}"
+            + ("\noptions not at their default: " + ", ".join(words for _, words in options) if options else ""))
 
 
 def _time_panel(ax: Axes, ds: xr.Dataset, name: str, observable: str, ylabel: str,
@@ -319,19 +423,23 @@ def _time_panel(ax: Axes, ds: xr.Dataset, name: str, observable: str, ylabel: st
 
 
 def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.PathLike[str] | None = None, *,
-                figure: Figure | None = None, dpi: int = DPI) -> Figure:
+                figure: Figure | None = None, dpi: int = DPI, read_from: str | None = None) -> Figure:
     r"""The standard panels of a result: what to look at before reading the numbers.
 
     Four panels against t (tau_th; a logarithmic axis over t > 0): the
     number of rearrangements n, the largest threshold mu_max, the mean
     square displacement <x_G^2> (each an ensemble mean with a band of
     +- one standard error over the realizations) and mu_eff of the virtual
-    tilt test (pooled over the tests, with its standard error). The closed
+    tilt test (pooled over the tests, with its standard error); a fifth,
+    the contact age (mean over the nodes of the time since their last slip),
+    where the result records it. The closed
     forms of :func:`theory_overlays` are drawn over them where they apply,
     and the legend says why one is not. A panel whose variable was not
     recorded says which observable to add. A network's result gets two more
     panels: its slip map (:func:`slip_map`) and mu_s field
-    (:func:`mu_s_field`) of realization 0.
+    (:func:`mu_s_field`) of realization 0. The title gives the scene and
+    the model's parameters, and names every option that is not at its
+    default (:func:`non_default_options`).
 
     Parameters
     ----------
@@ -348,13 +456,17 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
         figure, outside pyplot.
     dpi : int
         Resolution of a raster file, in dots per inch.
+    read_from : str, optional
+        The path of the file that ``result``, a dataset, was read from: the
+        title and the errors name it.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Its first four axes are the time panels (n, mu_max, <x_G^2>, mu_eff),
-        in that order; a network's slip map and mu_s field follow (each with
-        its colorbar in 2D).
+        Its first axes are the time panels (n, mu_max, <x_G^2>, mu_eff, and
+        the contact age where the result records it), in that order; a
+        network's slip map and mu_s field follow (each with its colorbar in
+        2D).
 
     Raises
     ------
@@ -385,11 +497,7 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     """
     from slidernet.config import build_network, load_config
 
-    if isinstance(result, (xr.Dataset, xr.DataTree)):
-        ds, source, name = result, "The dataset", None
-    else:
-        file = Path(result)
-        ds, source, name = _read(file), f"The file {str(file)!r}", file.name
+    ds, source, name = _load(result, read_from)
     _check_result(ds, source)
     if path is not None:
         _check_format(Path(path))
@@ -409,31 +517,34 @@ def plot_result(result: xr.Dataset | str | os.PathLike[str], path: str | os.Path
     if fig is None:
         fig = Figure()
         FigureCanvasAgg(fig)
+    panels = time_panels(ds)
+    rows = (len(panels) + 1) // 2  # the time panels, two per row; the maps below them
     two_d = net is not None and net.dim == 2
-    fig.set_size_inches(11.0, 12.5 if two_d else (10.5 if maps else 7.5))
+    fig.set_size_inches(11.0, 3.4 * rows + (5.7 if two_d else (3.7 if maps else 0.7)))
     # The 2D maps size their markers for their axes when drawn: no layout engine may move them later.
     if two_d:
-        grid = fig.add_gridspec(3, 2, height_ratios=(1.0, 1.0, 1.5), left=0.08, right=0.95, bottom=0.04,
-                                top=0.93, hspace=0.32, wspace=0.25)
+        grid = fig.add_gridspec(rows + 1, 2, height_ratios=(1.0,) * rows + (1.5,), left=0.08, right=0.95,
+                                bottom=0.04, top=0.93, hspace=0.32, wspace=0.25)
     else:
         fig.set_layout_engine("constrained")
-        grid = fig.add_gridspec(3 if maps else 2, 2)
+        grid = fig.add_gridspec(rows + maps, 2)
     t = ds["t"].values
     log_t = bool((t > 0).any())
     first = None
-    for k, (var, observable, ylabel) in enumerate(TIME_PANELS):
+    for k, (var, observable, ylabel) in enumerate(panels):
         ax = fig.add_subplot(grid[k // 2, k % 2], sharex=first)
         first = first or ax
-        _time_panel(ax, ds, var, observable, ylabel, panel_overlays[var], log_t)
-        if k >= 2:
+        _time_panel(ax, ds, var, observable, ylabel, panel_overlays.get(var, []), log_t)
+        if k >= len(panels) - 2:
             ax.set_xlabel(r"$t/\tau_\mathrm{th}$ (dimensionless time)")
     if log_t:
         first.set_xscale("log")
     if maps:
-        slip_map(ds, 0, ax=fig.add_subplot(grid[2, 0]), network=net)
-        mu_s_field(ds, 0, ax=fig.add_subplot(grid[2, 1]), network=net)
+        slip_map(ds, 0, ax=fig.add_subplot(grid[rows, 0]), network=net)
+        mu_s_field(ds, 0, ax=fig.add_subplot(grid[rows, 1]), network=net)
     heading = name or ds.attrs.get("title", "slidernet result")
-    fig.suptitle(heading if cfg_dict is None else f"{heading}: {_summary(cfg_dict, ds)}", fontsize=10)
+    options = non_default_options(cfg) if cfg is not None else []
+    fig.suptitle(heading if cfg_dict is None else f"{heading}: {_summary(cfg_dict, ds, options)}", fontsize=10)
     if path is not None:
         save_figure(fig, path, dpi=dpi)
     return fig

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import signal
 import time
@@ -16,7 +17,7 @@ from tqdm.auto import tqdm
 
 from slidernet._paths import absolute_path
 from slidernet._version import __version__, code_digest
-from slidernet.analysis.observables import CHUNK, assemble
+from slidernet.analysis.observables import CHUNK, assemble, avalanche_bins
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, load_config
 from slidernet.config.execution import scheduler_address_problem
 from slidernet.config.loading import input_files
@@ -34,6 +35,7 @@ from slidernet.errors import (
     param_error,
 )
 from slidernet.io import read_result
+from slidernet.io.checkpoint import read_arrays
 from slidernet.io.netcdf import open_result
 from slidernet.io.store import RunStore, changed_code, changed_inputs, file_digest
 from slidernet.solver import budget
@@ -269,8 +271,12 @@ def run(
         if store is None:
             ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
         else:
-            path = write_result_stream(store.records(R), out / "result.nc", scene.out_steps, R,
-                                       list(cfg.observables), attrs)
+            records = store.records(R)
+            first = next(records)
+            # The avalanche histogram's bins end where every realization's do: known before any is written.
+            bins = _size_bins(store, R) if "avalanche_count" in first else None
+            path = write_result_stream(itertools.chain([first], records), out / "result.nc", scene.out_steps, R,
+                                       list(cfg.observables), attrs, bins)
             store.remove()
             ds = open_result(path)
     except RunInterrupted:
@@ -300,6 +306,17 @@ def run(
             store.close()
     warn_if_all_slid_away(ds)
     return ds
+
+
+def _size_bins(store: RunStore, R: int) -> int:
+    """:func:`~slidernet.analysis.observables.avalanche_bins` over the store's R realizations, from their
+    ``avalanche_count`` alone (the whole blocks, every checksum checked, are read as the result is written)."""
+    rows: dict[Path, list[int]] = {}
+    for r, (path, row) in sorted(store.done().items()):
+        if r < R:
+            rows.setdefault(path, []).append(row)
+    return max(avalanche_bins(read_arrays(path, ["avalanche_count"])["avalanche_count"][taken])
+               for path, taken in rows.items())
 
 
 def all_slid_away(ds: xr.Dataset) -> str | None:

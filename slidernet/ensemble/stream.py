@@ -18,7 +18,7 @@ from slidernet.io import result_writer
 
 
 def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray, R: int,
-                        observables: list[str], attrs: dict[str, str]) -> Path:
+                        observables: list[str], attrs: dict[str, str], size_bins: int | None = None) -> Path:
     """Write a result to netCDF chunk by chunk, atomically; memory does not grow with R.
 
     The same variables, bits and encoding as :func:`slidernet.analysis.observables.assemble`
@@ -40,11 +40,21 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
         The requested observables.
     attrs : dict
         Global attributes.
+    size_bins : int, optional
+        The avalanche size bins to keep, :func:`slidernet.analysis.observables.avalanche_bins`
+        over every realization (assemble finds them itself; here the first chunk is
+        written before the last is read). Required where the records count avalanches.
 
     Returns
     -------
     pathlib.Path
         ``path``.
+
+    Raises
+    ------
+    ValueError
+        If the records count avalanches and ``size_bins`` is not given, or
+        there are not R of them.
     """
     from slidernet.analysis.observables import EnsembleStats, chunks, coordinates, realization_variables
 
@@ -54,12 +64,14 @@ def write_result_stream(records: Iterable[dict], path: str | Path, t: np.ndarray
         r0 = 0
         for chunk in chunks(records):
             if r0 == 0:  # the coordinates come whole, and first: they make the dimensions
-                for name, (dim, data, *rest) in coordinates(t, R, chunk[0]).items():
+                if "avalanche_count" in chunk[0] and size_bins is None:
+                    raise ValueError("write_result_stream needs size_bins for records that count avalanches")
+                for name, (dim, data, *rest) in coordinates(t, R, chunk[0], size_bins).items():
                     out.write(name, dim, data, rest[0] if rest else {}, coordinate=True)
             # This chunk's slips go on where the previous chunk's ended; rows of creep
             # events shorter than the longest so far read NaN, as assemble pads them.
             start = {"realization": r0, "event": out.size("event")}
-            for name, (dims, data, var_attrs) in realization_variables(chunk, observables, r0).items():
+            for name, (dims, data, var_attrs) in realization_variables(chunk, observables, r0, size_bins).items():
                 out.write(name, dims, data, var_attrs, start=start)
             stats.add(chunk)
             r0 += len(chunk)

@@ -55,7 +55,10 @@ Absent variables
     beside the pair kernel; ``y_G`` of 2D beside 1D) is stacked all the same,
     NaN where a point lacks it, as :func:`xarray.concat` fills it: its
     dtype becomes float64 (an int64 count is exact below 2^53). A variable
-    every point gives keeps its dtype and bits.
+    every point gives keeps its dtype and bits. Each point's
+    ``avalanche_count`` ends at its own highest occupied bin; the sweep's
+    ``avalanche_size`` is the widest point's, the others padded with empty
+    bins (zeros, int64 kept where every point has the histogram).
 Per-node variables
     Those along ``node`` (``node_slips``, ``mu_s``). Where every point's
     network has the same number of nodes they are stacked with the rest,
@@ -116,6 +119,7 @@ import xarray as xr
 from tqdm.auto import tqdm
 
 from slidernet._version import __version__, code_digest
+from slidernet.analysis.observables import align_avalanche_sizes
 from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted, SizeError
@@ -708,6 +712,8 @@ def _combine(results: list[xr.Dataset], keys: list[str], grid: Mapping[str, list
     (else an empty list).
     """
     results = [r.isel(t=slice(0, t_common.size)) if "t" in r.dims else r for r in results]
+    # Each point's avalanche histogram ends at its own largest avalanche: empty bins up to the widest.
+    results = align_avalanche_sizes(results)
     # Only whether a point has a variable may differ (_check_layout sees to the rest): a variable's dims or a
     # coordinate that differ between points is a bug, never padded.
     names = _union([[str(n) for n in r.data_vars] for r in results])
