@@ -21,7 +21,8 @@ A case passes when:
 - it runs past ``--case-timeout`` seconds having said it would be slow (a
   ``slidernet: warning:`` line) or with a slow-run estimate of at least a
   tenth of the timeout (:func:`slidernet.solver.budget.warn_if_slow`'s
-  estimate may be 11 times short), and then one SIGTERM ends it, within
+  estimate is within a factor 2 on the study's scenes,
+  ``benchmarks/slip_rate_estimate.py``, and may be further off elsewhere), and then one SIGTERM ends it, within
   ``--stop-timeout`` seconds, with exit 143 (128 + SIGTERM).
 
 It fails on exit status 1 (slidernet's "internal error"), any Python
