@@ -64,9 +64,11 @@ _DRIVER = {"name": "gaussian_steps", "sigma_theta": 1e-7}
 
 
 def _base(network: dict[str, Any], **top: Any) -> dict[str, Any]:
+    # allow_implausible: the mutations reach every valid value, not only those of real materials (the
+    # plausibility check itself is tests/test_plausibility.py's)
     cfg = {"seed": 1, "realizations": 2, "steps": 30, "observables": ["n", "mu_max", "x_G"],
            "network": {"Ntilde": 1e-7, **network}, "friction": copy.deepcopy(_FRICTION),
-           "driver": copy.deepcopy(_DRIVER)}
+           "driver": copy.deepcopy(_DRIVER), "allow_implausible": True}
     cfg.update(top)
     return cfg
 
