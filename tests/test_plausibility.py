@@ -35,10 +35,10 @@ def raw(Ntilde: float = 1e-7, sigma_theta: float = 1e-7, strengthening: dict | N
 
 def test_the_issues_unit_slip_is_refused() -> None:
     # sigma_theta = 1 K typed where alpha * 1 K = 1e-5 was meant, with the paper's Ntilde
-    with pytest.raises(ConfigError, match=r"sigma_theta = 1 is far outside what real materials give \(about "
-                                          r"8e-11 to 0\.07; see `slidernet units`\): sigma_theta is the "
-                                          r"dimensionless dilation alpha\*DeltaT .*not a temperature in kelvin\. "
-                                          r"Set allow_implausible = true to run it anyway"):
+    with pytest.raises(ConfigError, match=r"sigma_theta = 1 \(sigma_theta / Ntilde = 1e\+07\) is far outside what "
+                                          r"real materials give \(about 8e-11 to 0\.07; see `slidernet units`\): "
+                                          r"sigma_theta is the dimensionless dilation alpha\*DeltaT .*not a "
+                                          r"temperature in kelvin\. Set allow_implausible = true to run it"):
         load_config(raw(sigma_theta=1.0))
 
 
@@ -53,7 +53,8 @@ REFUSED = [
     pytest.param(raw(strengthening={"beta": 0.01, "tau_c": 1e6}),
                  r"strengthening\.tau_c = 1e\+06 is far outside .*in units of tau_th", id="tau_c-1e6"),
     pytest.param(raw(driver={"name": "sinusoidal", "amplitude": 3.0, "period": 10.0}),
-                 r"amplitude = 3 is far outside .*amplitude is the dimensionless dilation", id="amplitude-3"),
+                 r"amplitude = 3 \(amplitude / Ntilde = 3e\+07\) is far outside .*amplitude is the dimensionless "
+                 r"dilation", id="amplitude-3"),
 ]
 
 

@@ -150,13 +150,18 @@ def check(cfg: Any) -> None:
     if cfg.allow_implausible:
         return
     found = ranges()
+    values = _values(cfg)
     reasons = []
-    for name, (label, value) in _values(cfg).items():
+    for name, (label, value) in values.items():
         r = found[name]
         if r.low <= value <= r.high:
             continue
         slip = (r.too_low if value < r.low else r.too_high).format(key=label.split(" ")[0])
-        reasons.append(f"{label} = {value:.3g} is far outside what real materials give (about {r.low:.2g} to "
-                       f"{r.high:.2g}; see `slidernet units`): {slip}")
+        # the drive that the scale of theta gives, where the ratio is not named on its own
+        drive = values.get("sigma_theta / Ntilde") if name == "sigma_theta" else None
+        also = f" ({drive[0]} = {drive[1]:.3g})" if drive and found["sigma_theta / Ntilde"].low <= drive[1] \
+            <= found["sigma_theta / Ntilde"].high else ""
+        reasons.append(f"{label} = {value:.3g}{also} is far outside what real materials give (about {r.low:.2g} "
+                       f"to {r.high:.2g}; see `slidernet units`): {slip}")
     if reasons:
         raise ValueError("; ".join(reasons) + ". Set allow_implausible = true to run it anyway")
