@@ -404,7 +404,15 @@ def relieved(x: np.ndarray) -> np.ndarray:
     >>> relieved(np.array([0.0, 1.0, 100.0])).round(3).tolist()
     [0.0, 0.44, 98.743]
     """
-    return x * x / (x + 4.0 / np.pi)
+    return relieved_force(np.asarray(x, dtype=np.float64), 1.0)
+
+
+def relieved_force(size: np.ndarray, hold: np.ndarray | float) -> np.ndarray:
+    """:func:`relieved` (size / hold) times hold, in N: the force relieved by a node whose force changes by
+    ``size`` a step, with hold = mu_d N_i; finite wherever size is (a hold of 1e-300 N included)."""
+    size = np.asarray(size, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(size > 0, size / (1.0 + (4.0 / np.pi) * hold / size), 0.0)
 
 
 def _couplings(ops, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -456,8 +464,7 @@ def slips_per_tau(cfg: Config, scene: Scene, found: Scales | None = None) -> flo
     per_slip = 2.0 * s.gap * s.normal_load
     g = np.asarray(ops.g, dtype=np.float64).reshape(N, -1) * s.step
     if scene.network.is_two_slider():
-        share = relieved(s.load * s.step / hold) * hold / per_slip
-        return float(share.max())
+        return float((relieved_force(s.load * s.step, hold) / per_slip).max())
     # nodes loaded in this generation and their loads; the generation each node was first reached
     nodes = np.flatnonzero(s.load > 0)
     load = g[nodes]
@@ -471,7 +478,7 @@ def slips_per_tau(cfg: Config, scene: Scene, found: Scales | None = None) -> flo
         nodes, load, size, x = nodes[keep], load[keep], size[keep], x[keep]
         if nodes.size == 0:
             break
-        relief = relieved(x) * hold[nodes]
+        relief = relieved_force(size, hold[nodes])
         total += float((relief / per_slip[nodes]).sum())
         R = load * (relief / size)[:, None]
         src, dst, C = _couplings(ops, nodes)
