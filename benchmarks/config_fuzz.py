@@ -21,7 +21,8 @@ A case passes when:
 - it runs past ``--case-timeout`` seconds having said it would be slow (a
   ``slidernet: warning:`` line) or with a slow-run estimate of at least a
   tenth of the timeout (:func:`slidernet.solver.budget.warn_if_slow`'s
-  estimate may be 11 times short), and then one SIGTERM ends it, within
+  estimate is within a factor 2 on the study's scenes,
+  ``benchmarks/slip_rate_estimate.py``, and may be further off elsewhere), and then one SIGTERM ends it, within
   ``--stop-timeout`` seconds, with exit 143 (128 + SIGTERM).
 
 It fails on exit status 1 (slidernet's "internal error"), any Python
@@ -63,9 +64,11 @@ _DRIVER = {"name": "gaussian_steps", "sigma_theta": 1e-7}
 
 
 def _base(network: dict[str, Any], **top: Any) -> dict[str, Any]:
+    # allow_implausible: the mutations reach every valid value, not only those of real materials (the
+    # plausibility check itself is tests/test_plausibility.py's)
     cfg = {"seed": 1, "realizations": 2, "steps": 30, "observables": ["n", "mu_max", "x_G"],
            "network": {"Ntilde": 1e-7, **network}, "friction": copy.deepcopy(_FRICTION),
-           "driver": copy.deepcopy(_DRIVER)}
+           "driver": copy.deepcopy(_DRIVER), "allow_implausible": True}
     cfg.update(top)
     return cfg
 

@@ -52,6 +52,9 @@ checkpoint_every = 60.0
 
 
 LONG_STEP = """\
+# sigma_theta = 1 is a unit slip (1 K for alpha*DeltaT), far outside real materials: the point of this
+# case, a step of minutes, is a stress test of the interrupt
+allow_implausible = true
 seed = 1
 realizations = 4
 steps = 3

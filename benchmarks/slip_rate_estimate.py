@@ -5,12 +5,14 @@ of docs/guides/aging-networks.md as of commit a921f70 (the earlier grid of ``exa
 "slips/tau_th", the rate of rearrangements measured over 16 realizations of the horizontal evolution, 300 to
 1e4 tau_th, network seed 0), :func:`slidernet.solver.budget.slips_per_tau` from the
 same configuration (``examples/aging_networks.toml`` with the row's network, sigma_mu and sigma_theta), and
-the ratio estimate / measured. The slow-run warning (:func:`slidernet.solver.budget.warn_if_slow`) and the
-ensembles guide ("Before a run") quote these ratios as the estimate's error.
+the ratio estimate / measured. It exits with status 1, naming the scenes, when any ratio is outside
+[1/2, 2] (``FACTOR``). The slow-run warning (:func:`slidernet.solver.budget.warn_if_slow`), the ensembles
+guide ("Before a run") and the performance guide quote these ratios as the estimate's error.
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from slidernet.config import load_config, read_toml
@@ -26,9 +28,13 @@ MEASURED = [
     ("irregular", 4096, 0.1, 1, 81520.0), ("irregular", 16, 0.1, 10, 3244.0), ("irregular", 64, 0.1, 10, 22690.0),
 ]
 
+#: The largest factor between the estimate and the measured rate, either way.
+FACTOR = 2.0
 
-def main() -> None:
+
+def main() -> int:
     base = read_toml(Path(__file__).resolve().parents[1] / "examples" / "aging_networks.toml")
+    outside = []
     print(f"{'network':>10} {'N':>5} {'ratio':>5} {'sig/Nt':>6} {'measured':>10} {'estimate':>10} {'est/meas':>8}")
     for kind, n, ratio, sig, measured in MEASURED:
         raw = dict(base, realizations=1, steps=10_000, observables=["n"], mu_eff_at="auto")
@@ -39,7 +45,15 @@ def main() -> None:
         estimate = budget.slips_per_tau(cfg, Scene.from_config(cfg))
         print(f"{kind:>10} {n:5d} {ratio:5.1f} {sig:6g} {measured:10.4g} {estimate:10.4g} "
               f"{estimate / measured:8.2f}")
+        if not 1 / FACTOR <= estimate / measured <= FACTOR:
+            outside.append(f"{kind} {n} at sigma_theta / Ntilde = {sig:g} ({estimate / measured:.2f}x)")
+    if outside:
+        print(f"FAIL: the estimate is outside a factor {FACTOR:g} of the measured rate for {len(outside)} of "
+              f"{len(MEASURED)} scenes: " + "; ".join(outside))
+        return 1
+    print(f"OK: the estimate is within a factor {FACTOR:g} of the measured rate for all {len(MEASURED)} scenes")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -16,7 +16,6 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import slidernet
@@ -159,7 +158,7 @@ def test_scenes_float64_cannot_resolve_are_refused_naming_precision_and_the_para
         raise AssertionError("a realization ran before the precision was checked")
 
     monkeypatch.setattr(runner, "compile_kernels", no_realization)
-    raw = config(changes)
+    raw = config(changes, allow_implausible=True)  # float64's limits lie far outside real materials
     with pytest.raises(PrecisionError, match=r"float64 cannot resolve .*Lost floating-point precision; the cause: "
                                              + cause) as refused:
         slidernet.run(raw, workers=1, progress=False)
@@ -172,7 +171,7 @@ def test_scenes_float64_cannot_resolve_are_refused_naming_precision_and_the_para
     pytest.param({"network.k": 1e3, "network.kappa": 1e3}, id="k-kappa-1e3"),
 ])
 def test_scenes_within_float64_are_not_refused(changes: dict) -> None:
-    cfg = load_config(config(changes))
+    cfg = load_config(config(changes, allow_implausible=True))  # Ntilde = 1: far outside real materials
     budget.check_precision(cfg, Scene.from_config(cfg))
 
 
@@ -210,15 +209,33 @@ def test_the_study_runs_without_a_warning() -> None:
     assert seconds < 60
 
 
-@pytest.mark.parametrize(("sigma", "ratio"), [pytest.param(1.0, 1.96, id="sigma-1"),
-                                              pytest.param(10.0, 1.06, id="sigma-10")])
-def test_two_sliders_estimate_is_eq_slope_without_its_offset(sigma: float, ratio: float) -> None:
-    """Against the study's measured 2.887 and 53.16 slips per tau_th (docs/guides/aging-networks.md)."""
-    cfg = load_config(config(network={"kind": "chain", "n": 2, "Ntilde": 1e-7},
-                             driver={"name": "gaussian_steps", "sigma_theta": sigma * 1e-7}, steps=10**5))
+#: Scenes of the study's table (docs/guides/aging-networks.md; benchmarks/slip_rate_estimate.py has all 18):
+#: (network, sigma_theta / Ntilde, measured slips per tau_th). The estimate was 1.96, 0.20, 0.09 and 0.59 of
+#: these before it followed the band's loss and the front of relieved load.
+STUDY_RATES = [({"kind": "chain", "n": 2}, 1.0, 2.887), ({"kind": "chain", "n": 8}, 10.0, 577.6),
+               ({"kind": "chain", "n": 16}, 10.0, 1276.0),
+               ({"kind": "irregular", "n": 256, "seed": 0}, 1.0, 6422.0)]
+
+
+@pytest.mark.parametrize(("network", "sigma", "measured"), STUDY_RATES,
+                         ids=["two-sliders-1", "chain-8-10", "chain-16-10", "irregular-256-1"])
+def test_the_estimate_is_within_a_factor_2_of_the_measured_rate(network: dict, sigma: float,
+                                                                 measured: float) -> None:
+    cfg = load_config(config(network=network | {"Ntilde": 1e-7}, steps=10**4,
+                             driver={"name": "gaussian_steps", "sigma_theta": sigma * 1e-7}))
     estimate = budget.slips_per_tau(cfg, Scene.from_config(cfg))
-    assert estimate == pytest.approx(sigma / (np.sqrt(np.pi) * 0.1), rel=0.02)
-    assert estimate / {1.0: 2.887, 10.0: 53.16}[sigma] == pytest.approx(ratio, abs=0.03)
+    assert 0.5 <= estimate / measured <= 2.0, estimate / measured
+
+
+def test_the_ends_of_a_chain_load_its_middle_in_opposite_directions() -> None:
+    # A chain of 3 at sigma_theta / Ntilde = 10: the fronts from its two ends cancel at node 1, so it slips
+    # like two ends alone (the measured 5.775 is twice the two sliders' 2.887 at 1; here at 10).
+    def rate(n: int) -> float:
+        cfg = load_config(config(network={"kind": "chain", "n": n, "Ntilde": 1e-7}, steps=10**4,
+                                 driver={"name": "gaussian_steps", "sigma_theta": 1e-6}))
+        return budget.slips_per_tau(cfg, Scene.from_config(cfg))
+
+    assert rate(3) == pytest.approx(2 * rate(2), rel=0.02)
 
 
 def test_the_estimate_counts_the_time_to_build_a_large_network() -> None:

@@ -95,7 +95,9 @@ def test_the_precision_check_sees_nan_as_the_worst_case():
 def test_2d_networks_at_huge_sigma_theta_over_ntilde_slip_without_a_traceback(network, sigma_theta):
     # The issue's scenes: about 5e8 slips per driven node and step (a run of hours, which the SlowRunWarning
     # announces), so the realization is stopped after its first ~100 refills of 4096 draws, ~4e5 slips.
-    cfg = load_config(_config(network, steps=2, **{"driver.sigma_theta": sigma_theta, "solver.batch": 4096}))
+    # allow_implausible: the unit slip of issue 46 (sigma_theta in kelvin), run on purpose
+    cfg = load_config(_config(network, steps=2, **{"driver.sigma_theta": sigma_theta, "solver.batch": 4096,
+                                                   "allow_implausible": True}))
     real = Realization(Scene.from_config(cfg), np.random.SeedSequence(0))
     polls = iter(range(100))
     real.advance(stop=lambda: next(polls, None) is None)

@@ -18,6 +18,7 @@ from slidernet.config.creep import CreepConfig
 from slidernet.config.dynamics import DynamicsConfig
 from slidernet.config.execution import ExecutionConfig
 from slidernet.config.network import NetworkConfig
+from slidernet.config.plausibility import check as check_plausibility
 from slidernet.config.plugins import (
     FrictionConfig,
     PluginSpec,
@@ -62,6 +63,7 @@ class Config(_Strict):
     # "plugins" too: a configuration without it dumps as it did before the key existed, so that
     # stored results and interrupted runs (run.json) still match it.
     _omit_if_none: ClassVar[tuple[str, ...]] = ("creep", "plugins", "tilt", "shs", "dynamics")
+    _omit_if_default: ClassVar[tuple[str, ...]] = ("allow_implausible",)
 
     seed: Seed | None = Field(
         None, description="Seed of the run, in [0, 2^128): realization r is driven by child r of "
@@ -113,6 +115,11 @@ class Config(_Strict):
                           "process, before the names of [friction.static] and [driver] are looked up. Every "
                           "worker imports them again, so a file must be at the same path where the workers "
                           "run. None: none.")
+
+    allow_implausible: bool = Field(
+        False, description="Run a scene far outside what real materials give (slidernet.config.plausibility: "
+                           "Ntilde, sigma_theta, their ratio, the strengthening's beta and tau_c), which is "
+                           "otherwise refused as a likely unit slip.")
 
     _distribution: Any = PrivateAttr(default=None)
     _driver: Any = PrivateAttr(default=None)
@@ -205,6 +212,11 @@ class Config(_Strict):
             raise ValueError(f"the 'creep.transient' value must be < steps = {self.steps} (the run's duration, "
                              f"in tau_th), so that a reptation velocity is measured after it. "
                              f"Got {self.creep_settings().transient!r} instead")
+        return self
+
+    @model_validator(mode="after")
+    def _check_plausible(self) -> Config:
+        check_plausibility(self)  # after every validity check: a scene that cannot run is told why first
         return self
 
     def _check_tilt_table(self, tilt: TiltConfig) -> None:
