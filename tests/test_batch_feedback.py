@@ -3,11 +3,6 @@ notice's measured time, the scheduler's timeout as said."""
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
 from slidernet import ConfigError, UnknownPluginError

@@ -100,8 +100,10 @@ def unknown_keys(source: Mapping[str, Any], path: Sequence[str] = ()) -> list[st
     table whose model takes any key (a plugin's parameters) or that is not
     a table is left to the validation.
 
-    >>> unknown_keys({"realisations": 2, "network": {"kind": "chain", "Ntide": 1e-7}})
-    ["Unknown key 'realisations'; did you mean 'realizations'?", "Unknown key 'Ntide' in [network]; did you mean 'Ntilde'?"]
+    >>> for line in unknown_keys({"realisations": 2, "network": {"kind": "chain", "Ntide": 1e-7}}):
+    ...     print(line)
+    Unknown key 'realisations'; did you mean 'realizations'?
+    Unknown key 'Ntide' in [network]; did you mean 'Ntilde'?
     """
     model = _model_at(path)
     if model is None or model.model_config.get("extra") != "forbid":
