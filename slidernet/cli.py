@@ -201,9 +201,12 @@ def _with_cli_plugins(config: Path, plugins: list[str] | None) -> Path | dict:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
+
+    # Validate before any work or any file, and before the solver's modules (numba, xarray, distributed) are
+    # imported: an error in the configuration is reported at once.
+    cfg = load_config(_with_cli_plugins(args.config, args.plugins))
     from slidernet.ensemble.runner import all_slid_away, run
 
-    cfg = load_config(_with_cli_plugins(args.config, args.plugins))  # validate before any work or any file
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SlidAwayWarning)  # said below, once, as a line of its own
         ds = run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,

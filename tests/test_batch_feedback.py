@@ -3,6 +3,10 @@ notice's measured time, the scheduler's timeout as said."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
+
 import pytest
 
 from slidernet import ConfigError, UnknownPluginError
@@ -44,3 +48,47 @@ def test_every_unknown_key_is_listed():
 def test_an_unknown_plugin_name_names_the_nearest(key, name, nearest, clean_registries):
     with pytest.raises(UnknownPluginError, match=rf"Unknown \w+ '{name}'; did you mean '{nearest}'\? Available: "):
         load_config(make_config(**{key: name}))
+
+
+# ---------------------------------------------------------------------------
+# errors in a configuration before the heavy imports
+
+HEAVY = ("numba", "xarray", "distributed", "scipy", "matplotlib", "dask")
+
+# Runs `slidernet run` on a configuration in this process, then prints which heavy modules it had imported.
+_RUN_AND_LIST = """
+import json, sys
+from slidernet.cli import main
+status = main(["run", sys.argv[1], "--out", sys.argv[2]])
+print(json.dumps({"status": status, "imported": [m for m in sys.argv[3:] if m in sys.modules]}))
+"""
+
+
+PAIR_TOML = """\
+seed = 1
+{top}
+[network]
+kind = "two_slider"
+{network}
+[friction]
+mu_d = 0.5
+static = {{name = "gaussian", mean = 0.6, std = 0.01}}
+[driver]
+name = "gaussian_steps"
+sigma_theta = 1e-6
+"""
+
+
+@pytest.mark.parametrize(("top", "network"), [
+    pytest.param("realisations = 2\nsteps = 10", "Ntilde = 1e-7", id="unknown-key"),
+    pytest.param("realizations = 2\nsteps = 10", "Ntide = 1e-7", id="unknown-key-in-table"),
+    pytest.param("realizations = 2\nsteps = 0", "Ntilde = 1e-7", id="out-of-range"),
+])
+def test_a_bad_configuration_is_refused_before_the_heavy_imports(tmp_path, top, network):
+    config = tmp_path / "bad.toml"
+    config.write_text(PAIR_TOML.format(top=top, network=network))
+    proc = subprocess.run([sys.executable, "-c", _RUN_AND_LIST, str(config), str(tmp_path / "out"), *HEAVY],
+                          capture_output=True, text=True, timeout=120)
+    assert json.loads(proc.stdout) == {"status": 2, "imported": []}, proc.stderr
+    assert proc.stderr.startswith("slidernet: error: Invalid configuration:")
+    assert not (tmp_path / "out").exists()
