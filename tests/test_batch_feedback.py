@@ -92,3 +92,36 @@ def test_a_bad_configuration_is_refused_before_the_heavy_imports(tmp_path, top, 
     assert json.loads(proc.stdout) == {"status": 2, "imported": []}, proc.stderr
     assert proc.stderr.startswith("slidernet: error: Invalid configuration:")
     assert not (tmp_path / "out").exists()
+
+
+# ---------------------------------------------------------------------------
+# a scheduler that does not answer
+
+
+def test_an_unanswering_scheduler_is_given_the_timeout_the_message_states(monkeypatch):
+    import socket
+
+    import distributed
+
+    import slidernet
+    from slidernet.ensemble import runner
+    from slidernet.errors import SchedulerError
+
+    with socket.socket() as s:  # a local port nobody listens on once this socket is closed
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    given, compiled = [], []
+    real = distributed.Client
+
+    def client(address, **kwargs):
+        given.append(kwargs.get("timeout"))
+        return real(address, **kwargs)
+
+    monkeypatch.setattr(distributed, "Client", client)
+    monkeypatch.setattr(runner, "compile_kernels", lambda *a, **k: compiled.append(a))
+    address = f"tcp://127.0.0.1:{port}"
+    with pytest.raises(SchedulerError, match=rf"^Cannot reach the Dask scheduler at '{address}' within 0\.5 s "
+                                             r"\(execution\.scheduler_timeout\): "):
+        slidernet.run(make_config(realizations=2, steps=10), scheduler=address, scheduler_timeout=0.5)
+    assert given == [0.5]
+    assert compiled == []  # connected before the kernels compile: the wait is the one stated

@@ -20,7 +20,7 @@ from slidernet.analysis.observables import CHUNK, assemble
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, load_config
 from slidernet.config.execution import scheduler_address_problem
 from slidernet.config.loading import input_files
-from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
+from slidernet.ensemble.execution import StopSignal, available_cores, connect, execute, scene_of
 from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import (
     CheckpointError,
@@ -340,16 +340,24 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
         partial = None if store is None else str(store.partial(r))
         return config_json, cfg.seed, r, partial, ex.checkpoint_every, meta
 
+    # The scheduler first: one that does not answer is reported after the timeout it states, not after the
+    # kernels are compiled too.
+    client = connect(scheduler, timeout) if scheduler is not None and pending else None
     if pending:
         # In this process, before any worker starts: forked workers inherit the compiled kernels, and
         # the others load them from the cache instead of each compiling them again.
-        compile_kernels(cfg, notice=terminal_notice(progress))
+        try:
+            compile_kernels(cfg, notice=terminal_notice(progress))
+        except BaseException:
+            if client is not None:
+                client.close()
+            raise
     bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
                disable=None if progress is None else not progress)
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
     with StopSignal(ex.stop_timeout) as stop:
-        results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout)
+        results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout, client=client)
         try:
             try:
                 for r, rec in results:
