@@ -149,13 +149,25 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _progress_flag(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--no-progress", action="store_true",
-                   help="hide the progress bar (it is shown only when stderr is a terminal)")
+    shown = p.add_mutually_exclusive_group()
+    shown.add_argument("--no-progress", action="store_true",
+                       help="show no progress (default: a bar when stderr is a terminal, else a plain line "
+                            "every 30 s: done, slips per second, time left)")
+    shown.add_argument("--progress-every", dest="progress_every", type=_seconds, metavar="SECONDS",
+                       help="a plain progress line every SECONDS of wall time, on a terminal too")
 
 
-def _progress(args: argparse.Namespace) -> bool | None:
-    """False with --no-progress; else None: a bar only when stderr is a terminal (tqdm's rule)."""
-    return False if args.no_progress else None
+def _seconds(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, not {text!r}")
+    return value
+
+
+def _progress(args: argparse.Namespace) -> bool | float | None:
+    """False with --no-progress, the seconds of --progress-every; else None: a bar on a terminal, lines
+    elsewhere (slidernet.ensemble.progress)."""
+    return False if args.no_progress else args.progress_every
 
 
 def _execution_flags(p: argparse.ArgumentParser) -> None:

@@ -3,7 +3,9 @@ notice's measured time, the scheduler's timeout as said."""
 
 from __future__ import annotations
 
+import io
 import json
+import re
 import subprocess
 import sys
 
@@ -11,6 +13,7 @@ import pytest
 
 from slidernet import ConfigError, UnknownPluginError
 from slidernet.config import load_config
+from slidernet.ensemble.progress import Progress
 from tests.conftest import make_config
 
 # ---------------------------------------------------------------------------
@@ -125,3 +128,116 @@ def test_an_unanswering_scheduler_is_given_the_timeout_the_message_states(monkey
         slidernet.run(make_config(realizations=2, steps=10), scheduler=address, scheduler_timeout=0.5)
     assert given == [0.5]
     assert compiled == []  # connected before the kernels compile: the wait is the one stated
+
+
+# ---------------------------------------------------------------------------
+# progress lines
+
+
+class _Clock:
+    """A clock the test moves: the lines and the estimate's check read it, never the wall time."""
+
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def _progress(progress=None, stream=None, **options):
+    clock, stream = _Clock(), stream if stream is not None else io.StringIO()
+    return Progress(4, progress, "realizations", stream=stream, clock=clock, background=False, **options), clock
+
+
+def test_without_a_terminal_progress_is_a_line_at_each_interval():
+    bar, clock = _progress(None)  # a StringIO is not a terminal
+    clock.now += 29.0
+    bar.update(1, slips=290_000)
+    assert bar.stream.getvalue() == ""  # not yet 30 s
+    clock.now += 1.0
+    bar.tick()
+    clock.now += 10.0
+    bar.tick()  # 10 s after the line: none
+    assert bar.stream.getvalue().splitlines() == [
+        "slidernet: realizations 1/4 done (25%), 9.67e+03 slips/s, 30 s elapsed, about 1.5 min left"]
+
+
+def test_the_interval_is_the_number_given_and_a_last_line_says_where_it_ended():
+    bar, clock = _progress(5.0, stream=_Terminal())  # a number: lines even on a terminal
+    clock.now += 5.0
+    bar.tick()
+    bar.update(4, slips=100)
+    bar.close()
+    assert bar.stream.getvalue().splitlines() == [
+        "slidernet: realizations 0/4 done (0%), 5 s elapsed, time left unknown until one finishes",
+        "slidernet: realizations 4/4 done (100%), 20 slips/s, 5 s elapsed"]
+
+
+@pytest.mark.parametrize(("progress", "stream"), [
+    pytest.param(False, io.StringIO(), id="off"),
+    pytest.param(None, _Terminal(), id="terminal-bar"),
+])
+def test_no_lines_when_off_or_on_a_terminal(progress, stream):
+    bar, clock = _progress(progress, stream=stream)
+    clock.now += 100.0
+    bar.update(1, slips=10)
+    bar.close()
+    assert "slidernet: realizations" not in stream.getvalue()
+
+
+@pytest.mark.parametrize(("done", "at", "said"), [
+    pytest.param(1, 70.0, "slidernet: this run is 7.0x slower than estimated (1 of 4 realizations done after "
+                          "1.2 min; the estimate was 40 s for all of them).", id="one-done"),
+    pytest.param(0, 100.0, "slidernet: this run is at least 10.0x slower than estimated (0 of 4 realizations "
+                           "done after 1.7 min; the estimate was 40 s for all of them).", id="none-done"),
+])
+def test_a_run_behind_its_estimate_says_so_once(done, at, said):
+    bar, clock = _progress(False, estimate=40.0, parallel=1)  # 10 s a realization, one at a time
+    bar.update(done)
+    clock.now += at
+    bar.tick()
+    bar.tick()
+    clock.now += 100.0
+    bar.tick()
+    assert [line for line in bar.stream.getvalue().splitlines() if "slower" in line] == []  # progress=False
+    bar, clock = _progress(3600.0, estimate=40.0, parallel=1)
+    bar.update(done)
+    clock.now += at
+    bar.tick()
+    bar.tick()
+    clock.now += 100.0
+    bar.tick()
+    lines = [line for line in bar.stream.getvalue().splitlines() if "slower" in line]
+    assert len(lines) == 1 and lines[0].startswith(said)
+
+
+@pytest.mark.parametrize(("done", "at"), [
+    pytest.param(1, 19.0, id="within-2x"),
+    pytest.param(0, 59.0, id="too-early-to-judge"),
+])
+def test_a_run_near_its_estimate_says_nothing(done, at):
+    bar, clock = _progress(3600.0, estimate=40.0, parallel=1)
+    clock.now -= 100.0  # the check starts after BEHIND_AFTER seconds
+    bar.start = clock.now
+    bar.update(done)
+    clock.now += at
+    bar.tick()
+    assert "slower" not in bar.stream.getvalue()
+
+
+def test_a_run_with_its_stderr_in_a_file_writes_progress_lines(tmp_path):
+    config = tmp_path / "pair.toml"
+    config.write_text(PAIR_TOML.format(top="realizations = 2\nsteps = 20", network="Ntilde = 1e-7"))
+    log = tmp_path / "log.txt"
+    with log.open("w") as err:
+        proc = subprocess.run([sys.executable, "-m", "slidernet", "run", str(config), "--out",
+                               str(tmp_path / "out")], stderr=err, stdout=subprocess.PIPE, text=True, timeout=300)
+    lines = log.read_text().splitlines()
+    assert proc.returncode == 0, lines
+    assert re.fullmatch(r"slidernet: realizations 2/2 done \(100%\), \S+ slips/s, \d+ s elapsed", lines[-1]), lines
+    assert "it/s" not in log.read_text() and "\r" not in log.read_text()  # no bar in a file

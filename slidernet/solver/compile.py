@@ -139,11 +139,10 @@ def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
-def terminal_notice(progress: bool | None) -> Callable[[str], None] | None:
-    """Where a caller with a progress flag says that it compiles: stderr where its bar would show (tqdm's
-    rule: ``None`` means only on a terminal), nowhere otherwise."""
-    shown = bool(progress) if progress is not None else sys.stderr.isatty()
-    return _stderr if shown else None
+def terminal_notice(progress: bool | float | None) -> Callable[[str], None] | None:
+    """Where a caller with a progress argument says that it compiles: stderr wherever its progress shows, as
+    a bar or as lines (:mod:`slidernet.ensemble.progress`); nowhere with ``progress=False``."""
+    return None if progress is False else _stderr
 
 
 def compile_kernels(configs: Config | Sequence[Config], notice: Callable[[str], Any] | None = _stderr) -> bool:
