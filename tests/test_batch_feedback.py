@@ -241,3 +241,66 @@ def test_a_run_with_its_stderr_in_a_file_writes_progress_lines(tmp_path):
     assert proc.returncode == 0, lines
     assert re.fullmatch(r"slidernet: realizations 2/2 done \(100%\), \S+ slips/s, \d+ s elapsed", lines[-1]), lines
     assert "it/s" not in log.read_text() and "\r" not in log.read_text()  # no bar in a file
+
+
+# ---------------------------------------------------------------------------
+# the compile notice from the time measured on this machine
+
+
+@pytest.fixture
+def empty_cache(tmp_path, monkeypatch):
+    """A kernel cache of its own, empty: no compile time is known."""
+    from slidernet.solver import compile as compile_module
+
+    monkeypatch.setattr(compile_module, "cache_dir", lambda: str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+class _Compiles:
+    """A realization whose advance() is numba compiling (the event it fires on a cache miss), or not."""
+
+    compiles = True
+
+    def __init__(self, *args) -> None:
+        pass
+
+    def advance(self) -> None:
+        from numba.core import event
+
+        if self.compiles:
+            with event.trigger_event("numba:compile"):
+                pass
+
+
+def test_the_notice_says_the_time_the_last_compile_took_here(empty_cache, monkeypatch):
+    from slidernet.solver import compile as compile_module
+    from slidernet.solver.scene import Scene
+
+    cfg = load_config(make_config(realizations=1, steps=10))
+    scene = Scene.from_config(cfg)
+    assert "how long is not known yet on this machine (it is measured this time)" in compile_module.compile_notice(
+        scene)
+    ticks = iter([100.0, 224.4, 300.0, 301.0])  # each compile's start and end, on the clock the recording reads
+    monkeypatch.setattr(compile_module, "Realization", _Compiles)
+    monkeypatch.setattr(compile_module, "_clock", lambda: next(ticks))
+    notices = []
+    assert compile_module.compile_kernels(cfg, notice=notices.append)
+    assert len(notices) == 1 and "not known yet" in notices[0]
+    assert json.loads((empty_cache / "compile_seconds.json").read_text()) == {compile_module.family(scene): 124.4}
+    assert "about 124 s the last time on this machine; later runs load" in compile_module.compile_notice(scene)
+    monkeypatch.setattr(_Compiles, "compiles", False)  # loaded from the cache: nothing measured, nothing said
+    assert not compile_module.compile_kernels(cfg, notice=notices.append)
+    assert len(notices) == 1 and compile_module.compile_times() == {compile_module.family(scene): 124.4}
+
+
+@pytest.mark.parametrize("content", [
+    pytest.param("{not json", id="not-json"),
+    pytest.param('["pair"]', id="not-a-table"),
+    pytest.param('{"pair": "fast", "1D network": -1}', id="not-seconds"),
+])
+def test_an_unreadable_record_of_compile_times_counts_as_none(empty_cache, content):
+    from slidernet.solver.compile import compile_times
+
+    empty_cache.mkdir()
+    (empty_cache / "compile_seconds.json").write_text(content)
+    assert compile_times() == {}
