@@ -304,3 +304,29 @@ def test_an_unreadable_record_of_compile_times_counts_as_none(empty_cache, conte
     empty_cache.mkdir()
     (empty_cache / "compile_seconds.json").write_text(content)
     assert compile_times() == {}
+
+
+def test_a_run_gives_its_progress_the_slow_run_estimate_and_the_slips(monkeypatch):
+    import slidernet
+    from slidernet.ensemble import runner
+
+    made = []
+
+    class Recorded(Progress):
+        def __init__(self, *args, **kwargs) -> None:
+            super().__init__(*args, **kwargs, background=False)
+            made.append(self)
+
+    estimates = []
+    check_run = runner.budget.check_run
+
+    def recorded_check(*args, **kwargs):
+        estimates.append(check_run(*args, **kwargs))
+        return estimates[-1]
+
+    monkeypatch.setattr(runner, "Progress", Recorded)
+    monkeypatch.setattr(runner.budget, "check_run", recorded_check)
+    ds = slidernet.run(make_config(realizations=2, steps=50), progress=3600.0, workers=1)
+    (bar,) = made
+    assert bar.estimate == estimates[0] > 0 and bar.parallel == 1
+    assert bar.slips == int(ds["n"].isel(t=-1).sum()) > 0
