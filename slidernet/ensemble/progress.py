@@ -26,6 +26,7 @@ thread, which waits for realizations that may take hours); tests drive
 from __future__ import annotations
 
 import math
+import os
 import sys
 import threading
 import time
@@ -35,6 +36,14 @@ from typing import TextIO
 from tqdm.auto import tqdm
 
 from slidernet.errors import param_error
+
+# Held while a line is written. A local pool forks its workers while the thread of the lines may be writing:
+# a child forked then would inherit the stream's lock held, and hang at its first write to stderr. Holding
+# this lock across every fork of the process keeps the fork out of a write.
+_WRITING = threading.Lock()
+if hasattr(os, "register_at_fork"):  # POSIX
+    os.register_at_fork(before=_WRITING.acquire, after_in_parent=_WRITING.release,
+                        after_in_child=_WRITING.release)
 
 #: Seconds of wall time between two progress lines (``progress=None`` without a terminal).
 INTERVAL = 30.0
@@ -215,10 +224,11 @@ class Progress:
                 f"and with --out saves its work.")
 
     def _write(self, line: str) -> None:
-        if self.bar is not None:
-            self.bar.write(line, file=self.stream)
-        else:
-            print(line, file=self.stream, flush=True)
+        with _WRITING:
+            if self.bar is not None:
+                self.bar.write(line, file=self.stream)
+            else:
+                print(line, file=self.stream, flush=True)
 
     def _beat(self) -> None:
         # Often enough for the estimate's check; the lines keep their own interval.

@@ -358,14 +358,15 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
             if client is not None:
                 client.close()
             raise
-    # The estimate is of the whole run: its share is the pending realizations'. A Dask worker runs one at a time.
-    bar = Progress(R, progress, "realizations", initial=R - len(pending),
-                   estimate=None if estimate is None else estimate * len(pending) / R,
-                   parallel=min(len(pending), 1 if scheduler else workers) or 1)
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
     with StopSignal(ex.stop_timeout) as stop:
         results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout, client=client)
+        # The estimate is of the whole run: its share is the pending realizations'. A Dask worker runs one
+        # realization at a time.
+        bar = Progress(R, progress, "realizations", initial=R - len(pending),
+                       estimate=None if estimate is None else estimate * len(pending) / R,
+                       parallel=min(len(pending), 1 if scheduler else workers) or 1)
         try:
             try:
                 for r, rec in results:
