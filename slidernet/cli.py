@@ -234,11 +234,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    from slidernet.config import read_toml
+    from slidernet.config.loading import check_keys
+
+    base = _with_cli_plugins(args.config, args.plugins)
+    check_keys(read_toml(base) if isinstance(base, Path) else base)  # a typo, before xarray and numba load
     import xarray as xr
 
     from slidernet.ensemble.sweep import parse_grid, sweep
 
-    result = sweep(_with_cli_plugins(args.config, args.plugins), parse_grid(args.sets),
+    result = sweep(base, parse_grid(args.sets),
                    progress=_progress(args), out=args.out,
                    resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                    scheduler_timeout=args.scheduler_timeout)

@@ -330,3 +330,14 @@ def test_a_run_gives_its_progress_the_slow_run_estimate_and_the_slips(monkeypatc
     (bar,) = made
     assert bar.estimate == estimates[0] > 0 and bar.parallel == 1
     assert bar.slips == int(ds["n"].isel(t=-1).sum()) > 0
+
+
+def test_a_sweep_of_a_configuration_with_a_typo_is_refused_before_the_heavy_imports(tmp_path):
+    config = tmp_path / "bad.toml"
+    config.write_text(PAIR_TOML.format(top="realisations = 2\nsteps = 10", network="Ntilde = 1e-7"))
+    sweep = '["sweep", sys.argv[1], "--set", "driver.sigma_theta=1e-7,1e-6", "--out", sys.argv[2]]'
+    code = _RUN_AND_LIST.replace('["run", sys.argv[1], "--out", sys.argv[2]]', sweep)
+    proc = subprocess.run([sys.executable, "-c", code, str(config), str(tmp_path / "out"), *HEAVY],
+                          capture_output=True, text=True, timeout=120)
+    assert json.loads(proc.stdout) == {"status": 2, "imported": []}, proc.stderr
+    assert "Unknown key 'realisations'; did you mean 'realizations'?" in proc.stderr

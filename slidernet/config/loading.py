@@ -118,6 +118,19 @@ def unknown_keys(source: Mapping[str, Any], path: Sequence[str] = ()) -> list[st
     return lines
 
 
+def check_keys(source: Mapping[str, Any]) -> None:
+    """Refuse a raw configuration with an unknown key (:func:`unknown_keys`), naming each and its nearest.
+
+    Raises
+    ------
+    ConfigError
+        Listing every unknown key, before anything else is checked.
+    """
+    unknown = unknown_keys(source)
+    if unknown:
+        raise _invalid(unknown)
+
+
 def read_toml(path: str | Path) -> dict[str, Any]:
     """A configuration file as a dict, not validated; relative file paths made absolute against the file's folder.
 
@@ -281,9 +294,7 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
         # Absolute in the stored configuration: workers that start in another folder find the same files.
         source = anchored(source, Path.cwd())
-        unknown = unknown_keys(source)
-        if unknown:
-            raise _invalid(unknown)
+        check_keys(source)
         _import_listed_plugins(source)
         try:
             cfg = Config.model_validate(dict(source))
