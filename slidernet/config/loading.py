@@ -1,10 +1,10 @@
 """Loading a configuration: from a TOML file or a dict to a validated :class:`Config` with its plugins built.
 
-Every check happens here, before any work: the files and modules of
-``plugins`` imported first (so that what they register can be named),
-unknown keys first (:func:`unknown_keys`, which needs nothing but the
-models' field names, so a typo is reported before numba, scipy or a plugin
-is imported), structure and ranges through pydantic, plugin names and parameters by
+Every check happens here, before any work: unknown keys first
+(:func:`unknown_keys`, which needs nothing but the models' field names, so
+a typo is reported before numba, scipy or a plugin is imported), then the
+files and modules of ``plugins`` imported (so that what they register can
+be named), structure and ranges through pydantic, plugin names and parameters by
 building the plugins, and the checks that need them built (an incline
 steeper than every threshold, a driver too short for the run). Pydantic's errors are rewritten as one
 :class:`~slidernet.errors.ConfigError` that names each field and the

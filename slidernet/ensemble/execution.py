@@ -625,8 +625,8 @@ def connect(scheduler: str, timeout: float) -> Any:
     distributed retries the connection until then, and gives up at that
     time (2.0 s of wall time for ``timeout=2``, 5.0 s for 5, to a local port
     nobody listens on). A run connects before it compiles its kernels, so
-    the time the message states is the time the user waits after the
-    configuration is checked.
+    that a compile (minutes, from a cold cache on a loaded machine) never
+    lengthens the wait the message states.
 
     Raises
     ------
