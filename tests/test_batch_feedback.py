@@ -154,8 +154,9 @@ def _progress(progress=None, stream=None, **options):
     return Progress(4, progress, "realizations", stream=stream, clock=clock, background=False, **options), clock
 
 
-def test_without_a_terminal_progress_is_a_line_at_each_interval():
-    bar, clock = _progress(None)  # a StringIO is not a terminal
+@pytest.mark.parametrize("progress", [None, True], ids=["none", "true"])
+def test_without_a_terminal_progress_is_a_line_at_each_interval(progress):
+    bar, clock = _progress(progress)  # a StringIO is not a terminal
     clock.now += 29.0
     bar.update(1, slips=290_000)
     assert bar.stream.getvalue() == ""  # not yet 30 s
@@ -181,6 +182,7 @@ def test_the_interval_is_the_number_given_and_a_last_line_says_where_it_ended():
 @pytest.mark.parametrize(("progress", "stream"), [
     pytest.param(False, io.StringIO(), id="off"),
     pytest.param(None, _Terminal(), id="terminal-bar"),
+    pytest.param(True, _Terminal(), id="terminal-bar-asked"),
 ])
 def test_no_lines_when_off_or_on_a_terminal(progress, stream):
     bar, clock = _progress(progress, stream=stream)

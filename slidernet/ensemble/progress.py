@@ -14,8 +14,8 @@ The ``progress`` argument of :func:`slidernet.run`, :func:`slidernet.ensemble.sw
 and :func:`slidernet.paper.reproduce`, one rule:
 
 - ``False``: nothing;
-- ``None``: a bar where stderr is a terminal, lines every :data:`INTERVAL` s where it is not;
-- ``True``: a bar;
+- ``True`` or ``None``: a bar where stderr is a terminal, lines every :data:`INTERVAL` s where it is
+  not (a script that asks for progress in a batch job gets lines, not a bar's carriage returns);
 - a number of seconds > 0: lines at that interval, terminal or not.
 
 A background thread writes the lines (the work runs in the caller's
@@ -63,9 +63,9 @@ def check_progress(progress: object, owner: str) -> None:
 
 def shows_lines(progress: bool | float | None, stream: TextIO | None = None) -> bool:
     """True if ``progress`` is given as plain lines on ``stream`` (default: stderr)."""
-    if progress is None:
+    if progress is None or progress is True:
         return not (stream or sys.stderr).isatty()
-    return not isinstance(progress, bool)
+    return progress is not False
 
 
 class Progress:

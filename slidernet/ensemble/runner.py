@@ -135,11 +135,11 @@ def run(
         The run configuration (docs/model.md section 5); a path is read as TOML.
     progress : bool, float or None
         Progress over realizations, all workers together: False nothing;
-        True a bar; a number of seconds, a plain line on stderr at that
-        interval (realizations done, slips per second, time left); None a
-        bar on a terminal and lines every 30 s elsewhere (a batch job's
-        log). Bar or lines, a run that falls twice behind the slow-run
-        estimate says so once (:mod:`slidernet.ensemble.progress`).
+        True or None a bar on a terminal and a plain line on stderr every
+        30 s elsewhere (a batch job's log: realizations done, slips per
+        second, time left); a number of seconds, lines at that interval.
+        Bar or lines, a run that falls twice behind the slow-run estimate
+        says so once (:mod:`slidernet.ensemble.progress`).
     on_realization : callable, optional
         Called with the index of each realization once it is done (for
         callers that drive their own progress display).

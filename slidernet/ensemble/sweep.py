@@ -312,8 +312,8 @@ def sweep(
         created.
     progress : bool, float or None
         Progress over the realizations of every point, as in
-        :func:`slidernet.run` (None: a bar on a terminal, a line every 30 s
-        elsewhere).
+        :func:`slidernet.run` (True or None: a bar on a terminal, a line
+        every 30 s elsewhere).
     on_realization : callable, optional
         Called as ``on_realization(i, r)`` once realization r of point i is
         done, or found done on resume (i: the point's index in C order, as

@@ -549,9 +549,9 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | float |
         machine) instead of :data:`FULL` (102 s; 183 s of CPU).
     progress : bool, float or None
         Progress over all the runs (estimated work, known upfront), as in
-        :func:`slidernet.run`: a bar, or lines at a number of seconds
-        apart; None: a bar on a terminal and a line every 30 s elsewhere
-        (a batch job's log).
+        :func:`slidernet.run`: True or None a bar on a terminal and a line
+        every 30 s elsewhere (a batch job's log); a number of seconds,
+        lines that far apart.
     resume : bool
         Continue the interrupted reproduction in ``out_dir``: finished runs
         are read back from ``out_dir/runs``, the interrupted one resumes.

@@ -320,8 +320,8 @@ def speed_error(out_dir: str | Path, quick: bool = False, progress: bool | float
     quick : bool
         The small preset (under 3 minutes) instead of the full one.
     progress : bool, float or None
-        Progress over the runs, as in :func:`slidernet.run` (None: a bar on
-        a terminal, a line every 30 s elsewhere).
+        Progress over the runs, as in :func:`slidernet.run` (True or None:
+        a bar on a terminal, a line every 30 s elsewhere).
 
     Returns
     -------
