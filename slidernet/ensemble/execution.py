@@ -619,20 +619,11 @@ class _QuietLostScheduler(logging.Filter):
 
 
 def connect(scheduler: str, timeout: float) -> Any:
-    """A ``distributed.Client`` of the scheduler at ``scheduler``, connected within ``timeout`` seconds.
+    """A ``distributed.Client`` of ``scheduler``, connected within ``timeout`` s (the client's own timeout:
+    2.0 s of wall time for 2 to a local port nobody listens on), or :class:`SchedulerError` in one line.
 
-    The timeout is the client's own (``Client(scheduler, timeout=timeout)``):
-    distributed retries the connection until then, and gives up at that
-    time (2.0 s of wall time for ``timeout=2``, 5.0 s for 5, to a local port
-    nobody listens on). A run connects before it compiles its kernels, so
-    that a compile (minutes, from a cold cache on a loaded machine) never
-    lengthens the wait the message states.
-
-    Raises
-    ------
-    SchedulerError
-        If the scheduler does not answer in time, refuses, or is
-        misconfigured (TLS): the user's to fix, in one line.
+    A run connects before it compiles its kernels: a compile (minutes from a cold cache on a loaded
+    machine) never lengthens the wait the message states.
     """
     from distributed import Client
 
