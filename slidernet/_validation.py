@@ -11,7 +11,8 @@ theory and the solver can all check values without importing one another:
 - :func:`checked_output`: what a plugin returns;
 - :func:`read_real`: a number read from a data file (a graph, a series, measured
   thresholds), refused naming the file and the line or element; :func:`is_number_text`
-  tells a header from a line of numbers.
+  tells a header from a line of numbers;
+- :func:`did_you_mean`: the nearest spelling of an unknown name, for the error that refuses it.
 
 One rule for every parameter: a real number is an ``int`` or a ``float``
 (any :class:`numbers.Real`, numpy's scalars included), never a ``bool`` and
@@ -23,9 +24,10 @@ JSON may give either; ``1e4`` is a float in TOML), never ``True`` or ``"3"``.
 
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -229,3 +231,19 @@ def checked_output(values: object, shape: tuple[int, ...], kind: str, name: str,
     if not np.isfinite(arr).all():
         raise PluginError(f"The {kind} {name!r} returned NaN or inf values from {call}.")
     return arr
+
+
+def did_you_mean(name: object, known: Iterable[str]) -> str:
+    """A question naming the known name nearest to an unknown ``name``, or ``""`` when none is near.
+
+    Near is :func:`difflib.get_close_matches`'s rule (a similarity ratio of
+    at least 0.6), so a typo is answered and an unrelated word is not.
+
+    >>> did_you_mean("realisations", ["seed", "realizations", "steps"])
+    "did you mean 'realizations'?"
+    >>> did_you_mean("colour", ["material", "size"])
+    ''
+    """
+    # Never the name itself: one listed but broken (a plugin that failed to load) is no suggestion.
+    close = difflib.get_close_matches(str(name), [k for k in known if k != str(name)], n=1)
+    return f"did you mean {close[0]!r}?" if close else ""

@@ -162,13 +162,25 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _progress_flag(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--no-progress", action="store_true",
-                   help="hide the progress bar (it is shown only when stderr is a terminal)")
+    shown = p.add_mutually_exclusive_group()
+    shown.add_argument("--no-progress", action="store_true",
+                       help="show no progress (default: a bar when stderr is a terminal, else a plain line "
+                            "every 30 s: done, slips per second, time left)")
+    shown.add_argument("--progress-every", dest="progress_every", type=_seconds, metavar="SECONDS",
+                       help="a plain progress line every SECONDS of wall time, on a terminal too")
 
 
-def _progress(args: argparse.Namespace) -> bool | None:
-    """False with --no-progress; else None: a bar only when stderr is a terminal (tqdm's rule)."""
-    return False if args.no_progress else None
+def _seconds(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, not {text!r}")
+    return value
+
+
+def _progress(args: argparse.Namespace) -> bool | float | None:
+    """False with --no-progress, the seconds of --progress-every; else None: a bar on a terminal, lines
+    elsewhere (slidernet.ensemble.progress)."""
+    return False if args.no_progress else args.progress_every
 
 
 def _execution_flags(p: argparse.ArgumentParser) -> None:
@@ -214,9 +226,12 @@ def _with_cli_plugins(config: Path, plugins: list[str] | None) -> Path | dict:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from slidernet.config import load_config
+
+    # Validate before any work or any file, and before the solver's modules (numba, xarray, distributed) are
+    # imported: an error in the configuration is reported at once.
+    cfg = load_config(_with_cli_plugins(args.config, args.plugins))
     from slidernet.ensemble.runner import all_slid_away, run
 
-    cfg = load_config(_with_cli_plugins(args.config, args.plugins))  # validate before any work or any file
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SlidAwayWarning)  # said below, once, as a line of its own
         ds = run(cfg, progress=_progress(args), out=args.out, resume=args.resume, workers=args.workers,
@@ -232,11 +247,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    from slidernet.config import read_toml
+    from slidernet.config.loading import check_keys
+
+    base = _with_cli_plugins(args.config, args.plugins)
+    check_keys(read_toml(base) if isinstance(base, Path) else base)  # a typo, before xarray and numba load
     import xarray as xr
 
     from slidernet.ensemble.sweep import parse_grid, sweep
 
-    result = sweep(_with_cli_plugins(args.config, args.plugins), parse_grid(args.sets),
+    result = sweep(base, parse_grid(args.sets),
                    progress=_progress(args), out=args.out,
                    resume=args.resume, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                    scheduler_timeout=args.scheduler_timeout)

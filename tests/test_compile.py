@@ -10,6 +10,7 @@ one line per cache file it saves ("data saved to ..."), i.e. per compile.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -168,7 +169,8 @@ def test_the_notice_names_what_is_compiled(changes, parts):
     scene = Scene.from_config(load_config(_scene_config(changes)))
     assert kernel_parts(scene) == parts
     line = compile_notice(scene)
-    assert all(p in line for p in parts) and "once per installation" in line and " s of CPU" in line
+    assert all(p in line for p in parts) and "once per installation" in line
+    assert re.search(r"about \d+ s the last time on this machine|how long is not known yet on this machine", line)
 
 
 def test_the_probe_is_small_and_keeps_the_kernel():

@@ -96,13 +96,15 @@ def test_bad_values_are_refused_naming_the_field(key, value, match):
 
 
 @pytest.mark.parametrize(
-    ("key", "name", "available"),
-    [("friction.static.name", "weibul", ", ".join(repr(n) for n in sorted(distributions.BUILTINS))),
-     ("driver.name", "sine", ", ".join(repr(n) for n in sorted(drivers.BUILTINS)))],
-    ids=["distribution", "driver"],
+    ("key", "name", "nearest", "available"),
+    [("friction.static.name", "weibul", "; did you mean 'weibull'?",
+      ", ".join(repr(n) for n in sorted(distributions.BUILTINS))),
+     ("driver.name", "sine", ".", ", ".join(repr(n) for n in sorted(drivers.BUILTINS)))],
+    ids=["distribution-near", "driver-none-near"],
 )
-def test_unknown_plugin_lists_the_available_ones(key, name, available, clean_registries):
-    with pytest.raises(UnknownPluginError, match=rf"Unknown \w+ '{name}'\. Available: {re.escape(available)}\."):
+def test_unknown_plugin_lists_the_available_ones(key, name, nearest, available, clean_registries):
+    with pytest.raises(UnknownPluginError, match=rf"Unknown \w+ '{name}'{re.escape(nearest)} Available: "
+                                                 rf"{re.escape(available)}\."):
         load_config(make_config(**{key: name}))
 
 

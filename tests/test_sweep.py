@@ -325,7 +325,7 @@ def test_the_paper_figure_3b_sweep_fills_its_progress_bar(tmp_path):
     jobs = [_Job(f"sweep_sigma_theta={s:g}", _config(s, 50, 2, 201, observables=("n",))) for s in (1e-7, 1e-6)]
     bar_owner = _Runner(jobs, progress=True, runs=tmp_path, resume=False)
     ds = bar_owner.sweep(jobs, "driver.sigma_theta", "fig3b")
-    assert bar_owner.bar.n == bar_owner.bar.total == sum(j.cost for j in jobs)
+    assert bar_owner.bar.done == bar_owner.bar.total == sum(j.cost for j in jobs)
     assert ds["sigma_theta"].values.tolist() == [1e-7, 1e-6]
     bar_owner.close()
 

@@ -1,8 +1,10 @@
 """Loading a configuration: from a TOML file or a dict to a validated :class:`Config` with its plugins built.
 
-Every check happens here, before any work: the files and modules of
-``plugins`` imported first (so that what they register can be named),
-structure and ranges through pydantic, plugin names and parameters by
+Every check happens here, before any work: unknown keys first
+(:func:`unknown_keys`, which needs nothing but the models' field names, so
+a typo is reported before numba, scipy or a plugin is imported), then the
+files and modules of ``plugins`` imported (so that what they register can
+be named), structure and ranges through pydantic, plugin names and parameters by
 building the plugins, and the checks that need them built (an incline
 steeper than every threshold, a driver too short for the run). Pydantic's errors are rewritten as one
 :class:`~slidernet.errors.ConfigError` that names each field and the
@@ -14,19 +16,22 @@ from __future__ import annotations
 import copy
 import math
 import sys
-from collections.abc import Mapping
+import typing
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from slidernet._paths import absolute_path, not_utf8
+from slidernet._validation import did_you_mean
 from slidernet.config.base import NOT_INT64, NOT_INTEGER, NOT_REAL, NOT_SEED
 from slidernet.config.run import Config
 from slidernet.errors import ConfigError
-from slidernet.model.builders import graph_files
-from slidernet.model.network import Network
 from slidernet.plugins.loader import absolute_entry, import_plugins, plugin_sources
+
+if TYPE_CHECKING:
+    from slidernet.model.network import Network
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -46,8 +51,8 @@ def _describe(err: Mapping[str, Any]) -> str:
         return f"The {loc!r} field is required."
     if kind == "extra_forbidden":
         parent, _, key = loc.rpartition(".")
-        where = f" in [{parent}]" if parent else ""
-        return f"Unknown key {key!r}{where}."
+        model = _model_at(parent.split(".") if parent else [])
+        return _unknown_key(key, parent, model.model_fields if model is not None else ())
     bounds = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",
               "less_than_equal": "<="}
     if kind in bounds:
@@ -62,6 +67,68 @@ def _describe(err: Mapping[str, Any]) -> str:
         msg = str(ctx.get("error", err["msg"]))
         return f"The {loc!r} field: {msg}." if loc else f"Invalid combination: {msg}."
     return f"The {loc!r} field: {err['msg']}. Got {got!r} instead."
+
+
+def _unknown_key(key: str, parent: str, known: Iterable[str]) -> str:
+    where = f" in [{parent}]" if parent else ""
+    nearest = did_you_mean(key, known)
+    return f"Unknown key {key!r}{where}; {nearest}" if nearest else f"Unknown key {key!r}{where}."
+
+
+def _table_model(annotation: Any) -> type[BaseModel] | None:
+    """The one model a field holds (``X`` or ``X | None``); None for a value, or a union of several models."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    models = [a for a in typing.get_args(annotation) if isinstance(a, type) and issubclass(a, BaseModel)]
+    return models[0] if len(models) == 1 else None
+
+
+def _model_at(path: Sequence[str]) -> type[BaseModel] | None:
+    """The model of the table at the dotted ``path`` of a configuration (``[]``: :class:`Config`), or None."""
+    model: type[BaseModel] | None = Config
+    for key in path:
+        field = model.model_fields.get(key) if model is not None else None
+        model = _table_model(field.annotation) if field is not None else None
+    return model
+
+
+def unknown_keys(source: Mapping[str, Any], path: Sequence[str] = ()) -> list[str]:
+    """The unknown keys of a raw configuration, one line each, naming the table and the nearest known key.
+
+    It reads only the models' field names: a configuration with a typo is
+    refused before anything heavy is imported or any plugin is loaded. A
+    table whose model takes any key (a plugin's parameters) or that is not
+    a table is left to the validation.
+
+    >>> for line in unknown_keys({"realisations": 2, "network": {"kind": "chain", "Ntide": 1e-7}}):
+    ...     print(line)
+    Unknown key 'realisations'; did you mean 'realizations'?
+    Unknown key 'Ntide' in [network]; did you mean 'Ntilde'?
+    """
+    model = _model_at(path)
+    if model is None or model.model_config.get("extra") != "forbid":
+        return []
+    lines = []
+    for key, value in source.items():
+        field = model.model_fields.get(key)
+        if field is None:
+            lines.append(_unknown_key(str(key), ".".join(path), model.model_fields))
+        elif isinstance(value, Mapping) and _table_model(field.annotation) is not None:
+            lines += unknown_keys(value, (*path, key))
+    return lines
+
+
+def check_keys(source: Mapping[str, Any]) -> None:
+    """Refuse a raw configuration with an unknown key (:func:`unknown_keys`), naming each and its nearest.
+
+    Raises
+    ------
+    ConfigError
+        Listing every unknown key, before anything else is checked.
+    """
+    unknown = unknown_keys(source)
+    if unknown:
+        raise _invalid(unknown)
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -171,6 +238,8 @@ def input_files(cfg: Config) -> dict[str, str]:
     dumped = cfg.model_dump(mode="json")
     files = {f"{name}.path": table["path"] for name, table in _path_tables(dumped).items()}
     if cfg.network.kind == "graph" and cfg.network.path is not None:
+        from slidernet.model.builders import graph_files
+
         nodes = graph_files(cfg.network.path).get("nodes")
         if nodes is not None:
             files["network.path (node file)"] = str(nodes)
@@ -225,13 +294,13 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
             raise ConfigError(f"A configuration must be a dict, a Config or a path; got {type(source).__name__}.")
         # Absolute in the stored configuration: workers that start in another folder find the same files.
         source = anchored(source, Path.cwd())
+        check_keys(source)
         _import_listed_plugins(source)
         try:
             cfg = Config.model_validate(dict(source))
         except ValidationError as exc:
             # dict.fromkeys: a union reports one error per member, often alike.
-            lines = "\n".join(f"  - {m}" for m in dict.fromkeys(_describe(e) for e in exc.errors()))
-            raise ConfigError(f"Invalid configuration:\n{lines}") from None
+            raise _invalid(dict.fromkeys(_describe(e) for e in exc.errors())) from None
     cfg.distribution()
     _check_incline_holds(cfg)
     driver = cfg.driver_plugin()
@@ -244,6 +313,10 @@ def load_config(source: Config | Mapping[str, Any] | str | Path) -> Config:
         except ConfigError as exc:
             raise ConfigError(f"The 'driver' field: {exc}") from None
     return cfg
+
+
+def _invalid(lines: Iterable[str]) -> ConfigError:
+    return ConfigError("Invalid configuration:\n" + "\n".join(f"  - {m}" for m in lines))
 
 
 def _import_listed_plugins(source: Mapping[str, Any]) -> None:

@@ -9,15 +9,18 @@ the network itself, built where it may be a 1D pair of sliders
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from slidernet.config.base import FiniteFloat, Integer, PositiveFloat, Seed, _Strict, unit
 from slidernet.errors import SlidernetError
-from slidernet.model.builders import KIND_DIMS, build
-from slidernet.model.network import Network, pair_tilt_applies
+
+# The model (numba's kernels, scipy's sparse matrices) is imported where a network is built: a configuration
+# is checked, and its errors reported, before any of it is imported (slidernet.config.loading).
+if TYPE_CHECKING:
+    from slidernet.model.network import Network
 
 _KIND_PARAMS = {
     "two_slider": set(),
@@ -115,6 +118,8 @@ class NetworkConfig(_Strict):
 
     def build(self) -> Network:
         """The network (its own ``seed``: the geometry is quenched), with the incline's f_ext."""
+        from slidernet.model.builders import build
+
         params = self.model_dump(exclude={"kind", "Ntilde", "seed", "incline"}, exclude_none=True)
         # seed None means 0, not fresh entropy: a network is part of the scene.
         rng = np.random.Generator(np.random.PCG64(self.seed or 0))
@@ -136,6 +141,8 @@ class NetworkConfig(_Strict):
         costs nothing to build, and a graph's file is read. A file that
         cannot be read gives None: building the scene reports it.
         """
+        from slidernet.model.builders import KIND_DIMS
+
         if KIND_DIMS[self.kind] == 2 or self.size() not in (2, None):
             return None
         try:
@@ -150,6 +157,8 @@ class NetworkConfig(_Strict):
 
     def pair_tilt_applies(self) -> bool:
         """True if the appendix's tilt test before every rearrangement applies (:func:`pair_tilt_applies`)."""
+        from slidernet.model.network import pair_tilt_applies
+
         net = self.pair_network()
         return net is not None and pair_tilt_applies(net)
 

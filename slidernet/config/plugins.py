@@ -12,17 +12,20 @@ from __future__ import annotations
 
 import inspect
 import math
-from typing import Annotated, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from slidernet.config.base import FiniteFloat, PositiveFloat, _Strict, unit
 from slidernet.errors import ConfigError
-from slidernet.kernels.strength import strengthening
 from slidernet.plugins import registry
-from slidernet.plugins.distributions import TruncatedBelow
 from slidernet.plugins.guard import build_plugin
+
+# The kernels and the distributions (numba, scipy) are imported where they are used: a configuration is
+# checked, and its errors reported, before any of them is imported (slidernet.config.loading).
+if TYPE_CHECKING:
+    from slidernet.plugins.distributions import TruncatedBelow
 
 
 class PluginSpec(BaseModel):
@@ -85,6 +88,8 @@ class StrengtheningConfig(_Strict):
         inf
         """
         try:
+            from slidernet.kernels.strength import strengthening
+
             return float(strengthening.py_func(self.constants(), float(age)))
         except OverflowError:  # math.expm1 of the power law past float64
             return math.inf
@@ -183,6 +188,8 @@ def build_distribution(friction: FrictionConfig) -> TruncatedBelow:
     sf(1e308)) are not shown: the values they give are judged here, and a
     raw numpy line before the refusal said nothing more.
     """
+    from slidernet.plugins.distributions import TruncatedBelow
+
     name = friction.static.name
     with np.errstate(all="ignore"):
         dist = _build_plugin(registry.distributions, friction.static, "friction.static")

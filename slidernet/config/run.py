@@ -9,7 +9,7 @@ recorded times against the duration), and builds its plugins once.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
@@ -31,10 +31,11 @@ from slidernet.config.shs import ShsConfig
 from slidernet.config.solver import SolverConfig
 from slidernet.config.tilt import TiltConfig
 from slidernet.config.units import _UNITS_RTOL, UnitsConfig, _fill_from_units
-from slidernet.model.builders import KIND_DIMS
-from slidernet.model.network import Network, pair_tilt_applies
 from slidernet.plugins import registry
-from slidernet.plugins.distributions import TruncatedBelow
+
+if TYPE_CHECKING:  # the model and the distributions are imported where used (slidernet.config.network says why)
+    from slidernet.model.network import Network
+    from slidernet.plugins.distributions import TruncatedBelow
 
 OBSERVABLES = ("n", "mu_max", "x_G", "mu_eff", "mu_eff_realization", "tilt_loads", "n_records", "events",
                "creep", "contact_age", "mu_shs")
@@ -300,6 +301,8 @@ class Config(_Strict):
 
     def _network_dim_and_pair(self) -> tuple[int | None, bool]:
         """(dimension, runs on the pair kernel) of the network, reading a graph file only if there is one."""
+        from slidernet.model.builders import KIND_DIMS
+
         pair = self.network.pair_network()  # a graph is built here, once
         dim = pair.dim if pair is not None else KIND_DIMS[self.network.kind]
         if dim is None:
@@ -330,6 +333,8 @@ class Config(_Strict):
         (:func:`~slidernet.model.network.pair_tilt_applies` of ``network``, or of the configured one,
         :meth:`NetworkConfig.pair_tilt_applies`) whose thresholds do not strengthen (its test reads the
         pair kernel's thresholds, which have no age)."""
+        from slidernet.model.network import pair_tilt_applies
+
         if self.friction.strengthening is not None or self.dynamics is not None:
             return False
         return self.network.pair_tilt_applies() if network is None else pair_tilt_applies(network)

@@ -618,21 +618,32 @@ class _QuietLostScheduler(logging.Filter):
         return not (self.lost and cancelled)
 
 
-def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
-          timeout: float) -> Iterator[tuple[int, Record]]:
+def connect(scheduler: str, timeout: float) -> Any:
+    """A ``distributed.Client`` of ``scheduler``, connected within ``timeout`` s (the client's own timeout:
+    2.0 s of wall time for 2 to a local port nobody listens on), or :class:`SchedulerError` in one line.
+
+    A run connects before it compiles its kernels: a compile (minutes from a cold cache on a loaded
+    machine) never lengthens the wait the message states.
+    """
     from distributed import Client
 
+    try:
+        return Client(scheduler, timeout=timeout)
+    except Exception as exc:
+        raise SchedulerError(
+            f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
+            f"(execution.scheduler_timeout): {_first_line(exc)}."
+        ) from None
+
+
+def _dask(indices: Sequence[int], args: Task, scheduler: str, stop: StopSignal,
+          timeout: float, client: Any = None) -> Iterator[tuple[int, Record]]:
     quiet = _QuietLostScheduler()
     log = logging.getLogger("distributed.client")
     log.addFilter(quiet)
     try:
-        try:
-            client = Client(scheduler, timeout=timeout)
-        except Exception as exc:  # unreachable, refused, or misconfigured (TLS): the user's to fix, in one line
-            raise SchedulerError(
-                f"Cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
-                f"(execution.scheduler_timeout): {_first_line(exc)}."
-            ) from None
+        if client is None:
+            client = connect(scheduler, timeout)
         with client:
             try:
                 yield from _dask_tasks(client, indices, args, scheduler, stop)
@@ -736,7 +747,8 @@ def _dask_tasks(client: Any, indices: Sequence[int], args: Task, scheduler: str,
 
 
 def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str | None = None,
-            stop: StopSignal | None = None, scheduler_timeout: float = 10.0) -> Iterator[tuple[int, Record]]:
+            stop: StopSignal | None = None, scheduler_timeout: float = 10.0,
+            client: Any = None) -> Iterator[tuple[int, Record]]:
     """Run the realizations ``indices``; yield ``(r, records)`` as they finish (in any order).
 
     Parameters
@@ -761,10 +773,14 @@ def execute(indices: Sequence[int], args: Task, workers: int = 1, scheduler: str
         Seconds to wait for the Dask scheduler before raising
         :class:`~slidernet.errors.SchedulerError`, which is also raised when
         the scheduler goes away during the run.
+    client : distributed.Client, optional
+        A client of ``scheduler`` already connected (:func:`connect`); the
+        iteration closes it when it ends. None: it connects when the
+        iteration starts.
     """
     stop = StopSignal() if stop is None else stop
     if scheduler is not None:
-        return _dask(indices, args, scheduler, stop, scheduler_timeout)
+        return _dask(indices, args, scheduler, stop, scheduler_timeout, client)
     if workers <= 1 or len(indices) <= 1:
         return _in_process(indices, args, stop)
     return _local_pool(indices, args, min(workers, len(indices)), stop)

@@ -13,7 +13,6 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from tqdm.auto import tqdm
 
 from slidernet._paths import absolute_path
 from slidernet._version import __version__, code_digest
@@ -21,7 +20,8 @@ from slidernet.analysis.observables import CHUNK, assemble, avalanche_bins
 from slidernet.config import SCHEDULER_REQUIREMENT, Config, load_config
 from slidernet.config.execution import scheduler_address_problem
 from slidernet.config.loading import input_files
-from slidernet.ensemble.execution import StopSignal, available_cores, execute, scene_of
+from slidernet.ensemble.execution import StopSignal, available_cores, connect, execute, scene_of
+from slidernet.ensemble.progress import Progress, check_progress
 from slidernet.ensemble.stream import write_result_stream
 from slidernet.errors import (
     CheckpointError,
@@ -119,7 +119,7 @@ def mu_eff_estimator(scene: Any) -> str:
 
 def run(
     config: Config | Mapping[str, Any] | str | Path,
-    progress: bool | None = False,
+    progress: bool | float | None = False,
     on_realization: Callable[[int], None] | None = None,
     *,
     out: str | Path | None = None,
@@ -135,9 +135,13 @@ def run(
     ----------
     config : Config, dict or path
         The run configuration (docs/model.md section 5); a path is read as TOML.
-    progress : bool or None
-        Show a progress bar over realizations, all workers together (None:
-        only on a terminal).
+    progress : bool, float or None
+        Progress over realizations, all workers together: False nothing;
+        True or None a bar on a terminal and a plain line on stderr every
+        30 s elsewhere (a batch job's log: realizations done, slips per
+        second, time left); a number of seconds, lines at that interval.
+        Bar or lines, a run that falls twice behind the slow-run estimate
+        says so once (:mod:`slidernet.ensemble.progress`).
     on_realization : callable, optional
         Called with the index of each realization once it is done (for
         callers that drive their own progress display).
@@ -229,6 +233,7 @@ def run(
     >>> bool((ds["mu_max"].diff("t") >= 0).all())
     True
     """
+    check_progress(progress, "run")
     requested = load_config(config)
     cfg = resolve_seed(requested)
     ex = cfg.execution
@@ -252,7 +257,7 @@ def run(
     budget.check_memory(budget.memory_estimate(cfg, 1 if scheduler else workers, streamed=out is not None))
     config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     scene = scene_of(config_json)  # validates the scene before any file is touched; forked workers inherit it
-    budget.check_run(cfg, scene, workers)
+    estimate = budget.check_run(cfg, scene, workers)
     run_identity = identity(requested, cfg)
     store = None
     if out is not None:
@@ -266,7 +271,8 @@ def run(
             config_json = json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
     try:
         done = store.done() if store is not None else {}
-        records = _execute(cfg, config_json, store, done, progress, on_realization, workers, scheduler, timeout)
+        records = _execute(cfg, config_json, store, done, progress, on_realization, workers, scheduler, timeout,
+                           estimate)
         attrs = _attrs(cfg, scene, workers, scheduler, run_identity["inputs"])
         if store is None:
             ds = assemble((records.pop(r) for r in range(R)), scene.out_steps, list(cfg.observables), attrs)
@@ -339,8 +345,8 @@ def warn_if_all_slid_away(ds: xr.Dataset) -> None:
 
 
 def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mapping[int, Any],
-             progress: bool | None, on_realization: Callable[[int], None] | None, workers: int,
-             scheduler: str | None, timeout: float) -> dict[int, dict]:
+             progress: bool | float | None, on_realization: Callable[[int], None] | None, workers: int,
+             scheduler: str | None, timeout: float, estimate: float | None = None) -> dict[int, dict]:
     """Run the realizations not ``done``; records kept in memory, or in ``store`` (flushed as they come).
 
     Ctrl-C and SIGTERM stop the run at a clean point of every running
@@ -357,19 +363,31 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
         partial = None if store is None else str(store.partial(r))
         return config_json, cfg.seed, r, partial, ex.checkpoint_every, meta
 
+    # The scheduler first: one that does not answer is reported after the timeout it states, not after the
+    # kernels are compiled too.
+    client = connect(scheduler, timeout) if scheduler is not None and pending else None
     if pending:
         # In this process, before any worker starts: forked workers inherit the compiled kernels, and
         # the others load them from the cache instead of each compiling them again.
-        compile_kernels(cfg, notice=terminal_notice(progress))
-    bar = tqdm(total=R, initial=R - len(pending), desc="realizations",
-               disable=None if progress is None else not progress)
+        try:
+            compile_kernels(cfg, notice=terminal_notice(progress))
+        except BaseException:
+            if client is not None:
+                client.close()
+            raise
     records: dict[int, dict] = {}
     last_flush = time.monotonic()
     with StopSignal(ex.stop_timeout) as stop:
-        results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout)
+        results = execute(pending, args, workers, scheduler, stop=stop, scheduler_timeout=timeout, client=client)
+        # The estimate is of the whole run: its share is the pending realizations'. A Dask worker runs one
+        # realization at a time.
+        bar = Progress(R, progress, "realizations", initial=R - len(pending),
+                       estimate=None if estimate is None else estimate * len(pending) / R,
+                       parallel=min(len(pending), 1 if scheduler else workers) or 1)
         try:
             try:
                 for r, rec in results:
+                    slips = int(rec["n"][-1]) if len(rec.get("n", ())) else 0  # the last record holds them all
                     if store is None:
                         records[r] = rec
                     else:
@@ -377,7 +395,7 @@ def _execute(cfg: Config, config_json: str, store: RunStore | None, done: Mappin
                         if time.monotonic() - last_flush >= ex.checkpoint_every or store.held >= CHUNK:
                             store.flush()
                             last_flush = time.monotonic()
-                    bar.update()
+                    bar.update(1, slips=slips)
                     if on_realization is not None:
                         on_realization(r)
             finally:

@@ -116,12 +116,12 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from tqdm.auto import tqdm
 
 from slidernet._version import __version__, code_digest
 from slidernet.analysis.observables import align_avalanche_sizes
 from slidernet.config import Config, load_config, read_toml
 from slidernet.ensemble import runner
+from slidernet.ensemble.progress import Progress, check_progress
 from slidernet.errors import CheckpointError, ConfigError, OutputError, RunInterrupted, SizeError
 from slidernet.io import atomic_output, write_netcdf
 from slidernet.io.store import locked_folder, read_identity_file
@@ -290,7 +290,7 @@ def sweep(
     config: Config | Mapping[str, Any] | str | Path,
     grid: Mapping[str, Sequence[Any]],
     *,
-    progress: bool | None = False,
+    progress: bool | float | None = False,
     on_realization: Callable[[int, int], None] | None = None,
     out: str | Path | None = None,
     resume: bool = False,
@@ -314,9 +314,10 @@ def sweep(
         Dotted key (``"driver.sigma_theta"``) -> the values it takes, in
         order. A value replaces the key's whole value; missing tables are
         created.
-    progress : bool or None
-        Show one progress bar over the realizations of every point (None:
-        only on a terminal).
+    progress : bool, float or None
+        Progress over the realizations of every point, as in
+        :func:`slidernet.run` (True or None: a bar on a terminal, a line
+        every 30 s elsewhere).
     on_realization : callable, optional
         Called as ``on_realization(i, r)`` once realization r of point i is
         done, or found done on resume (i: the point's index in C order, as
@@ -396,6 +397,7 @@ def sweep(
     >>> bool(tree["mu_min"].sel({"network.n": 2}).isnull().all())
     True
     """
+    check_progress(progress, "sweep")
     grid = _checked_grid(grid)
     base = _base_dict(config)
     options = {"progress": progress, "on_realization": on_realization, "resume": resume, "workers": workers,
@@ -408,7 +410,8 @@ def sweep(
         return _sweep(base, grid, Path(out), **options)
 
 
-def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None, *, progress: bool | None,
+def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None, *,
+           progress: bool | float | None,
            on_realization: Callable[[int, int], None] | None, resume: bool, workers: int | None,
            scheduler: str | None, overwrite: bool, scheduler_timeout: float | None) -> xr.Dataset | xr.DataTree:
     """:func:`sweep` of a checked grid, in ``folder`` (whose lock the caller holds) or in memory."""
@@ -443,7 +446,7 @@ def _sweep(base: dict[str, Any], grid: dict[str, list[Any]], folder: Path | None
     execution = {k: v for k, v in (("workers", workers), ("scheduler", scheduler),
                                    ("scheduler_timeout", scheduler_timeout)) if v is not None}
     R = cfgs[0].realizations
-    bar = tqdm(total=len(cfgs) * R, desc="sweep", disable=None if progress is None else not progress)
+    bar = Progress(len(cfgs) * R, progress, "sweep realizations")
     results = []
     try:
         for i, cfg in enumerate(cfgs):
@@ -555,7 +558,7 @@ def _run_point(cfg: Config, where: Path | None, resume: bool, done: Callable[[in
     return runner.run_in(cfg, where, resume=resume, on_realization=done, **execution)
 
 
-def _counter(bar: tqdm, on_realization: Callable[[int, int], None] | None, i: int) -> Callable[[int], None]:
+def _counter(bar: Progress, on_realization: Callable[[int, int], None] | None, i: int) -> Callable[[int], None]:
     def done(r: int) -> None:
         bar.update(1)
         if on_realization is not None:

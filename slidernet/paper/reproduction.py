@@ -45,11 +45,11 @@ import xarray as xr
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from tqdm.auto import tqdm
 
 from slidernet._version import __version__
 from slidernet.analysis import theory
 from slidernet.config import load_config
+from slidernet.ensemble.progress import Progress, check_progress
 from slidernet.ensemble.runner import run_in
 from slidernet.ensemble.sweep import sweep as run_sweep
 from slidernet.errors import CheckpointError, OutputError, RunInterrupted
@@ -162,13 +162,11 @@ class _Runner:
     the interrupted one continues to the same bits.
     """
 
-    def __init__(self, jobs: list[_Job], progress: bool | None, runs: Path, resume: bool) -> None:
+    def __init__(self, jobs: list[_Job], progress: bool | float | None, runs: Path, resume: bool) -> None:
         # Every kernel of every figure first, with one line if they must be compiled: the bar would
         # otherwise stand still while they compile.
         compile_kernels([load_config(j.config) for j in jobs], notice=terminal_notice(progress))
-        self.bar = tqdm(total=sum(j.cost for j in jobs), desc="paper figures",
-                        disable=None if progress is None else not progress,
-                        bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
+        self.bar = Progress(sum(j.cost for j in jobs), progress, "paper figures", unit=None)
         self.runs = runs
         self.resume = resume
 
@@ -536,7 +534,7 @@ def _plot_fig4(ds: xr.Dataset, sigma_theta: float, path: Path) -> None:
 # driver
 
 
-def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = True, *,
+def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | float | None = True, *,
               resume: bool = False, overwrite: bool = False, _preset: Preset | None = None) -> dict[str, Path]:
     """Reproduce the paper's four result figures (its Figs. 2 to 5), with their data, in ``out_dir``.
 
@@ -549,9 +547,11 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
     quick : bool
         Use the :data:`QUICK` preset (10 s of wall time on an idle 2-core
         machine) instead of :data:`FULL` (102 s; 183 s of CPU).
-    progress : bool or None
-        Show one progress bar over all the runs (estimated work, known
-        upfront); None: only on a terminal.
+    progress : bool, float or None
+        Progress over all the runs (estimated work, known upfront), as in
+        :func:`slidernet.run`: True or None a bar on a terminal and a line
+        every 30 s elsewhere (a batch job's log); a number of seconds,
+        lines that far apart.
     resume : bool
         Continue the interrupted reproduction in ``out_dir``: finished runs
         are read back from ``out_dir/runs``, the interrupted one resumes.
@@ -576,12 +576,13 @@ def reproduce(out_dir: str | Path, quick: bool = False, progress: bool | None = 
     FolderInUseError
         If another command works in ``out_dir`` (it holds the folder's lock).
     """
+    check_progress(progress, "reproduce")
     p = _preset if _preset is not None else (QUICK if quick else FULL)
     with locked_folder(Path(out_dir), "paper reproduction") as out:
         return _reproduce(out, p, bool(quick) if _preset is None else None, progress, resume, overwrite)
 
 
-def _reproduce(out: Path, p: Preset, quick: bool | None, progress: bool | None, resume: bool,
+def _reproduce(out: Path, p: Preset, quick: bool | None, progress: bool | float | None, resume: bool,
                overwrite: bool) -> dict[str, Path]:
     """:func:`reproduce` with preset ``p`` in ``out``, whose lock the caller holds (``quick`` None: own ``p``)."""
     start = time.perf_counter()

@@ -19,6 +19,7 @@ from collections.abc import Callable
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
+from slidernet._validation import did_you_mean
 from slidernet.errors import UnknownPluginError
 
 Factory = Callable[..., Any]
@@ -125,8 +126,10 @@ class Registry:
         """The error for a name no plugin has: the names there are, and the ways to add one."""
         available = ", ".join(repr(n) for n in self.names())
         register = _REGISTER_FUNCTIONS.get(self.kind, "Registry.register")
+        nearest = did_you_mean(name, self.names())
         return UnknownPluginError(
-            f"Unknown {self.kind} {name!r}. Available: {available}. To add one, install a package that "
+            f"Unknown {self.kind} {name!r}" + (f"; {nearest}" if nearest else ".")
+            + f" Available: {available}. To add one, install a package that "
             f"declares it as an entry point of the group {self.group!r}, list the Python file or module that "
             f"registers it under plugins = [...] in the configuration or with --plugin on the command line, "
             f"or call {register}(name, factory) in Python."

@@ -535,8 +535,9 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 60:.3g} minutes"
 
 
-def check_run(cfg: Config, scene: Scene, workers: int = 1) -> None:
-    """The checks of a scene before its run: :func:`check_precision`, then :func:`warn_if_slow`."""
+def check_run(cfg: Config, scene: Scene, workers: int = 1) -> float:
+    """The checks of a scene before its run: :func:`check_precision`, then :func:`warn_if_slow`; returns its
+    estimated seconds (the run's progress compares its pace with them)."""
     found = scales(cfg, scene)
     check_precision(cfg, scene, found)
-    warn_if_slow(cfg, scene, workers, found)
+    return warn_if_slow(cfg, scene, workers, found)

@@ -16,8 +16,13 @@ the cache. Forked workers inherit what the parent compiled.
 
 from __future__ import annotations
 
+import json
+import math
+import os
 import sys
+import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -38,26 +43,40 @@ _PROBE_SLIPS = 2000
 # The largest theta / Ntilde a probe is driven with (see probe_config).
 _PROBE_DRIVE = 100.0
 
-# CPU seconds to compile each part from an empty cache, one process, on the project's 2-core dev machine
-# (2026-11-27, `python benchmarks/cold_start.py`); the notice's estimate is their sum.
-_COMPILE_SECONDS = {
-    "pair": 3.5,
-    "pair tilt test": 1.5,
-    "1D network": 11.0,
-    "appendix's tilt test": 1.5,
-    "2D network": 12.5,
-    # Not timed from an empty cache: taken as the kernel without it (a few more inlined functions).
-    "1D network with contact strengthening": 11.0,
-    "2D network with contact strengthening": 12.5,
-    "exact 2D slip": 2.0,
-    "network tilt test": 7.0,
-    # Not timed from an empty cache: taken as the network tilt test's (the same body, another variant).
-    "slide-hold-slide": 7.0,
-    # compile_kernels of a chain of 4 and an irregular 16 with [dynamics], alone, from an empty cache, its
-    # process's CPU time (2026-11-28, load average 6 on the 2 cores).
-    "inertial solver (1D)": 39.0,
-    "inertial solver (2D)": 30.5,
-}
+# The wall seconds each family of kernels (a scene's kernel_parts, joined) took to compile the last time on
+# this machine, recorded after each compile, beside the compiled kernels: the notice's estimate. A fixed table
+# measured elsewhere (it said about 25 s) was 5 times short on a loaded machine.
+_TIMES_FILE = "compile_seconds.json"
+_clock = time.monotonic  # the clock of the measured time (a test's own where it checks what is recorded)
+
+
+def compile_times() -> dict[str, float]:
+    """The seconds each family of kernels took to compile the last time on this machine (``{}``: none known).
+
+    Read from ``compile_seconds.json`` in :func:`~slidernet.kernels.jit.cache_dir`, keyed by the family's
+    parts (``"1D network, network tilt test"``); a file that cannot be read counts as none.
+    """
+    try:
+        times = json.loads((Path(cache_dir()) / _TIMES_FILE).read_text())
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(times, dict):
+        return {}
+    return {k: float(v) for k, v in times.items() if isinstance(v, (int, float)) and math.isfinite(v) and v >= 0}
+
+
+def record_compile_time(family: str, seconds: float) -> None:
+    """Record that ``family`` took ``seconds`` to compile (replacing the time before); a cache folder that
+    cannot be written records nothing (the next notice then does not know)."""
+    times = {**compile_times(), family: round(float(seconds), 1)}
+    path = Path(cache_dir()) / _TIMES_FILE
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(times, indent=1, sort_keys=True))
+        os.replace(tmp, path)  # whole or not at all: two processes that compile at once never mix their writes
+    except OSError:
+        pass
 
 
 def probe_config(cfg: Config) -> Config | None:
@@ -126,24 +145,33 @@ def kernel_parts(scene: Scene) -> list[str]:
 
 
 def compile_notice(scenes: Scene | Sequence[Scene]) -> str:
-    """The line a first run prints before it compiles: what, that it happens once, about how long."""
-    parts = list(dict.fromkeys(p for scene in ([scenes] if isinstance(scenes, Scene) else scenes)
-                               for p in kernel_parts(scene)))
-    seconds = sum(_COMPILE_SECONDS[p] for p in parts)
+    """The line a first run prints before it compiles: what, that it happens once, about how long (the time
+    it took the last time on this machine, :func:`compile_times`, or that it is not known yet)."""
+    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    parts = list(dict.fromkeys(p for scene in scenes for p in kernel_parts(scene)))
+    known = compile_times()
+    families = [family(scene) for scene in scenes]
+    if all(f in known for f in families):
+        how_long = f"about {sum(known[f] for f in families):.0f} s the last time on this machine"
+    else:
+        how_long = "how long is not known yet on this machine (it is measured this time)"
     return (f"slidernet: compiling the kernels this run needs ({', '.join(parts)}) for this machine, once per "
-            f"installation: about {seconds:.0f} s of CPU on a small machine; later runs load them from "
-            f"{cache_dir()}.")
+            f"installation: {how_long}; later runs load them from {cache_dir()}.")
+
+
+def family(scene: Scene) -> str:
+    """The name of the kernels a scene compiles together (its :func:`kernel_parts`), the key of their time."""
+    return ", ".join(kernel_parts(scene))
 
 
 def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
-def terminal_notice(progress: bool | None) -> Callable[[str], None] | None:
-    """Where a caller with a progress flag says that it compiles: stderr where its bar would show (tqdm's
-    rule: ``None`` means only on a terminal), nowhere otherwise."""
-    shown = bool(progress) if progress is not None else sys.stderr.isatty()
-    return _stderr if shown else None
+def terminal_notice(progress: bool | float | None) -> Callable[[str], None] | None:
+    """Where a caller with a progress argument says that it compiles: stderr wherever its progress shows, as
+    a bar or as lines (:mod:`slidernet.ensemble.progress`); nowhere with ``progress=False``."""
+    return None if progress is False else _stderr
 
 
 def compile_kernels(configs: Config | Sequence[Config], notice: Callable[[str], Any] | None = _stderr) -> bool:
@@ -184,9 +212,12 @@ def compile_kernels(configs: Config | Sequence[Config], notice: Callable[[str], 
 
     with on_first_compile(said) as compiled:
         for scene in scenes.values():
-            with compile_lock(", ".join(kernel_parts(scene))):
+            with compile_lock(family(scene)), on_first_compile(lambda: None) as this:
+                start = _clock()  # after the lock: waiting for another process is not compiling
                 try:
                     Realization(scene, np.random.SeedSequence(0)).advance()
                 except SlidernetError:
                     pass
+            if this.compiled:
+                record_compile_time(family(scene), _clock() - start)
     return compiled.compiled

@@ -44,9 +44,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from slidernet.config import load_config
+from slidernet.ensemble.progress import Progress
 from slidernet.io import atomic_output, save_figure
 from slidernet.solver import Scene, horizontal_draws, realization_streams, simulate
 
@@ -216,7 +216,7 @@ def _step_label(max_step: float) -> str:
     return ", adaptive steps" if math.isinf(max_step) else f", steps <= {max_step:g} tau_dyn"
 
 
-def rows(preset: Preset, progress: bool | None = None) -> list[Row]:
+def rows(preset: Preset, progress: bool | float | None = None) -> list[Row]:
     """Run every method of the comparison and return one :class:`Row` per (method, setting)."""
     jobs: list[tuple[str, str, str, Callable[[], Final]]] = []
     pair_cfg = {**PAIR, "steps": preset.pair_steps, "record": [0, preset.pair_steps]}
@@ -253,12 +253,14 @@ def rows(preset: Preset, progress: bool | None = None) -> list[Row]:
     _warm_up()
     reference: dict[str, Final] = {}
     out = []
-    for method, setting, scene_name, fn in tqdm(jobs, desc="speed-error", disable=None if progress is None
-                                                  else not progress):
-        final, seconds = _timed(fn)
-        if method.startswith("event-driven") or (method == "2D slip" and setting == "exact"):
-            reference.setdefault(scene_name, final)
-        out.append(Row(method, setting, seconds, **errors(final, reference[scene_name]), scene=scene_name))
+    with Progress(len(jobs), progress, "speed-error runs") as bar:
+        for method, setting, scene_name, fn in jobs:
+            bar.set_postfix_str(f"{method} {setting}")
+            final, seconds = _timed(fn)
+            if method.startswith("event-driven") or (method == "2D slip" and setting == "exact"):
+                reference.setdefault(scene_name, final)
+            out.append(Row(method, setting, seconds, **errors(final, reference[scene_name]), scene=scene_name))
+            bar.update(1)
     return out
 
 
@@ -308,7 +310,7 @@ def plot(table: list[Row], path: str | Path) -> Path:
     return save_figure(fig, path, dpi=120)
 
 
-def speed_error(out_dir: str | Path, quick: bool = False, progress: bool | None = None) -> dict[str, Path]:
+def speed_error(out_dir: str | Path, quick: bool = False, progress: bool | float | None = None) -> dict[str, Path]:
     """Run the comparison and write ``speed_error.csv`` and ``speed_error.png`` into ``out_dir``.
 
     Parameters
@@ -317,8 +319,9 @@ def speed_error(out_dir: str | Path, quick: bool = False, progress: bool | None 
         Output directory (created if needed).
     quick : bool
         The small preset (under 3 minutes) instead of the full one.
-    progress : bool or None
-        Show a progress bar (None: only on a terminal).
+    progress : bool, float or None
+        Progress over the runs, as in :func:`slidernet.run` (True or None:
+        a bar on a terminal, a line every 30 s elsewhere).
 
     Returns
     -------
