@@ -199,22 +199,19 @@ def test_no_lines_when_off_or_on_a_terminal(progress, stream):
                            "done after 1.7 min; the estimate was 40 s for all of them).", id="none-done"),
 ])
 def test_a_run_behind_its_estimate_says_so_once(done, at, said):
-    bar, clock = _progress(False, estimate=40.0, parallel=1)  # 10 s a realization, one at a time
-    bar.update(done)
-    clock.now += at
-    bar.tick()
-    bar.tick()
-    clock.now += 100.0
-    bar.tick()
-    assert [line for line in bar.stream.getvalue().splitlines() if "slower" in line] == []  # progress=False
-    bar, clock = _progress(3600.0, estimate=40.0, parallel=1)
-    bar.update(done)
-    clock.now += at
-    bar.tick()
-    bar.tick()
-    clock.now += 100.0
-    bar.tick()
-    lines = [line for line in bar.stream.getvalue().splitlines() if "slower" in line]
+    def behind_lines(progress):
+        """The 'slower' lines of a run of 4 realizations (10 s each by the estimate) ticked at ``at`` and later."""
+        bar, clock = _progress(progress, estimate=40.0, parallel=1)
+        bar.update(done)
+        clock.now += at
+        bar.tick()
+        bar.tick()
+        clock.now += 100.0
+        bar.tick()
+        return [line for line in bar.stream.getvalue().splitlines() if "slower" in line]
+
+    assert behind_lines(False) == []  # progress=False says nothing
+    lines = behind_lines(3600.0)
     assert len(lines) == 1 and lines[0].startswith(said)
 
 
